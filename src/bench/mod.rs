@@ -1,0 +1,69 @@
+//! `lbdem bench ...`: rates printed with their ratio to a reference measured in the same
+//! run (the machine's memory bandwidth or a peer code), because this machine is shared
+//! and noisy and only ratios taken together mean anything.
+
+pub mod bandwidth;
+pub mod dem;
+pub mod grains;
+pub mod lbm;
+pub mod radiograph;
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Which {
+    /// STREAM-like copy and triad bandwidth.
+    Bandwidth,
+    /// Radiograph frames to REV g_S and eps_vol maps.
+    Radiograph,
+    /// D2Q9 stream-collide MLUPS.
+    Lbm,
+    /// DEM particle-steps per second.
+    Dem,
+    /// Two-circle grain fitting rate.
+    Grains,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct BenchArgs {
+    pub which: Which,
+    /// Repetitions; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub reps: usize,
+    /// Small sizes only (for CI smoke runs).
+    #[arg(long)]
+    pub quick: bool,
+    /// Also run the peer code (lbmpy, LAMMPS) if installed and report the ratio.
+    #[arg(long)]
+    pub peer: bool,
+    /// Write the results as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+pub fn run(a: &BenchArgs) -> Result<()> {
+    match a.which {
+        Which::Bandwidth => bandwidth::run(a),
+        Which::Radiograph => radiograph::run(a),
+        Which::Lbm => lbm::run(a),
+        Which::Dem => dem::run(a),
+        Which::Grains => grains::run(a),
+    }
+}
+
+/// Median of a sample (sorted copy); NaN-free input assumed.
+pub fn median(xs: &[f64]) -> f64 {
+    let mut v = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}

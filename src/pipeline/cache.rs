@@ -1,0 +1,91 @@
+//! Content-hash cache: a stage is skipped when its kind, parameters, input bytes and the
+//! code version hash to the key stored in its manifest and every output it listed exists.
+
+use super::{MANIFEST, StageRecord, code_version};
+use crate::stages::{Prepared, StageContext};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Eq)]
+pub struct InputHash {
+    pub path: PathBuf,
+    pub sha256: String,
+    pub bytes: u64,
+}
+
+/// SHA-256 of a file (streamed).
+pub fn hash_file(path: &Path) -> Result<InputHash> {
+    let mut f = std::fs::File::open(path)
+        .with_context(|| format!("input file {} cannot be opened", path.display()))?;
+    let mut h = Sha256::new();
+    let mut buf = vec![0u8; 1 << 20];
+    let mut bytes = 0u64;
+    loop {
+        let n = f
+            .read(&mut buf)
+            .with_context(|| format!("reading {}", path.display()))?;
+        if n == 0 {
+            break;
+        }
+        bytes += n as u64;
+        h.update(&buf[..n]);
+    }
+    Ok(InputHash {
+        path: path.to_path_buf(),
+        sha256: hex::encode(h.finalize()),
+        bytes,
+    })
+}
+
+/// Hash every input; a directory counts as all files in it (sorted, not recursive).
+pub fn hash_inputs(paths: &[PathBuf]) -> Result<Vec<InputHash>> {
+    let mut out = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let mut entries: Vec<PathBuf> = std::fs::read_dir(p)
+                .with_context(|| format!("cannot list input directory {}", p.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file())
+                .collect();
+            entries.sort();
+            for e in entries {
+                out.push(hash_file(&e)?);
+            }
+        } else {
+            out.push(hash_file(p)?);
+        }
+    }
+    Ok(out)
+}
+
+pub fn cache_key(kind: &str, params: &serde_json::Value, inputs: &[InputHash]) -> String {
+    let mut h = Sha256::new();
+    for part in [code_version().as_str(), kind, &params.to_string()] {
+        h.update(part.as_bytes());
+        h.update([0]);
+    }
+    let mut sorted: Vec<&InputHash> = inputs.iter().collect();
+    sorted.sort_by(|a, b| a.path.cmp(&b.path));
+    for i in sorted {
+        h.update(i.sha256.as_bytes());
+    }
+    hex::encode(h.finalize())
+}
+
+/// The stored record if the stage can be skipped.
+pub fn reusable(prepared: &Prepared, ctx: &StageContext) -> Result<Option<StageRecord>> {
+    let manifest = ctx.out_dir.join(MANIFEST);
+    let Ok(text) = std::fs::read_to_string(&manifest) else {
+        return Ok(None);
+    };
+    let Ok(old) = serde_json::from_str::<StageRecord>(&text) else {
+        return Ok(None);
+    };
+    let inputs = hash_inputs(&prepared.inputs)?;
+    let key = cache_key(&prepared.kind, &prepared.params_json, &inputs);
+    let complete = old.output.files.iter().all(|f| ctx.out_dir.join(f).is_file());
+    Ok((old.cache_key == key && complete).then_some(old))
+}

@@ -1,0 +1,113 @@
+//! The pipeline file.
+//!
+//! ```toml
+//! [pipeline]
+//! name = "quickstart"
+//! root = ".."                  # paths below resolve from here (relative to this file)
+//! out = "reports/quickstart"
+//!
+//! [[stage]]
+//! name = "radiograph"
+//! kind = "radiograph"
+//! [stage.params]
+//! frames = ["data/synth/frame_000.tif"]
+//! ```
+
+use anyhow::{Context, Result, bail};
+use serde::Deserialize;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct File {
+    pipeline: Header,
+    #[serde(default)]
+    stage: Vec<StageSpec>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Header {
+    name: String,
+    #[serde(default)]
+    root: Option<PathBuf>,
+    out: PathBuf,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StageSpec {
+    pub name: String,
+    pub kind: String,
+    #[serde(default = "empty_table")]
+    pub params: toml::Value,
+}
+
+fn empty_table() -> toml::Value {
+    toml::Value::Table(Default::default())
+}
+
+#[derive(Debug)]
+pub struct Pipeline {
+    pub name: String,
+    /// Directory that relative paths in the file resolve from.
+    pub root: PathBuf,
+    pub out: PathBuf,
+    pub stages: Vec<StageSpec>,
+}
+
+impl Pipeline {
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read pipeline file {}", path.display()))?;
+        Self::parse(&text, path)
+    }
+
+    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        let f: File =
+            toml::from_str(text).with_context(|| format!("pipeline file {} is not valid", path.display()))?;
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let root = match f.pipeline.root {
+            Some(r) if r.is_absolute() => r,
+            Some(r) => dir.join(r),
+            None => dir,
+        };
+        if f.stage.is_empty() {
+            bail!("pipeline file {} has no [[stage]] entries", path.display());
+        }
+        let mut seen = HashSet::new();
+        for s in &f.stage {
+            if !seen.insert(s.name.as_str()) {
+                bail!(
+                    "pipeline file {}: two stages are named '{}'; stage names must be unique",
+                    path.display(),
+                    s.name
+                );
+            }
+            if !crate::stages::KINDS.contains(&s.kind.as_str()) {
+                bail!(
+                    "pipeline file {}: stage '{}' has unknown kind '{}'; known kinds: {}",
+                    path.display(),
+                    s.name,
+                    s.kind,
+                    crate::stages::KINDS.join(", ")
+                );
+            }
+        }
+        Ok(Self {
+            name: f.pipeline.name,
+            root,
+            out: f.pipeline.out,
+            stages: f.stage,
+        })
+    }
+
+    pub fn out_dir(&self) -> PathBuf {
+        if self.out.is_absolute() {
+            self.out.clone()
+        } else {
+            self.root.join(&self.out)
+        }
+    }
+}

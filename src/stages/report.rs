@@ -1,0 +1,22 @@
+//! Stage `report` (work in progress on its issue branch).
+
+use super::{Stage, StageContext, StageOutput};
+use anyhow::{Result, bail};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+#[derive(Debug, Serialize, Deserialize)]
+pub struct Params {}
+
+pub struct Report;
+
+impl Stage for Report {
+    const KIND: &'static str = "report";
+    type Params = Params;
+    fn inputs(_: &Params, _: &StageContext) -> Vec<PathBuf> {
+        Vec::new()
+    }
+    fn run(_: &Params, _: &StageContext) -> Result<StageOutput> {
+        bail!("stage 'report' is not built yet")
+    }
+}
