@@ -114,42 +114,50 @@ fn run_and_record(
 }
 
 /// `lbdem run PIPELINE.toml`.
+///
+/// Every stage's parameters are parsed before anything runs or is written, so a typo in
+/// the last stage fails at once instead of after the long ones.
 pub fn run_file(path: &Path, force: bool) -> Result<()> {
     let pipeline = schema::Pipeline::load(path)?;
     let out = pipeline.out_dir();
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
-    let mut prov = provenance::Provenance::start(path, &pipeline)?;
+    let mut planned = Vec::new();
     let mut earlier = Vec::new();
-    let t_all = Instant::now();
     for spec in &pipeline.stages {
         let dir = if writes_in_place(&spec.kind) {
             out.clone()
         } else {
             out.join(&spec.name)
         };
-        let mut ctx = StageContext::new(dir, spec.name.clone(), pipeline.root.clone());
+        let mut ctx = StageContext::new(dir.clone(), spec.name.clone(), pipeline.root.clone());
         ctx.earlier = earlier.clone();
         ctx.pipeline_out = Some(out.clone());
-        let prepared = stages::prepare(&spec.kind, spec.params.clone(), &ctx)?;
+        let prepared = stages::prepare(&spec.kind, spec.params.clone(), &ctx)
+            .with_context(|| format!("pipeline file {}", path.display()))?;
+        earlier.push((spec.name.clone(), dir));
+        planned.push((ctx, prepared));
+    }
+    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    let mut prov = provenance::Provenance::start(path, &pipeline)?;
+    let t_all = Instant::now();
+    for (ctx, prepared) in planned {
         let record = match (force, cache::reusable(&prepared, &ctx)?) {
             (false, Some(mut old)) => {
                 eprintln!(
                     "{:>12}  unchanged, skipped (ran in {:.2} s before)",
-                    spec.name, old.wall_s
+                    ctx.name, old.wall_s
                 );
                 old.cached = true;
                 old
             }
             _ => {
-                eprintln!("{:>12}  running ({})", spec.name, spec.kind);
+                eprintln!("{:>12}  running ({})", ctx.name, prepared.kind);
                 let r = execute(prepared, &ctx)?;
-                eprintln!("{:>12}  done in {:.2} s", spec.name, r.wall_s);
+                eprintln!("{:>12}  done in {:.2} s", ctx.name, r.wall_s);
                 r
             }
         };
         prov.add(&record, &ctx.out_dir);
         prov.write(&out)?;
-        earlier.push((spec.name.clone(), ctx.out_dir.clone()));
     }
     prov.total_wall_s = t_all.elapsed().as_secs_f64();
     prov.write(&out)?;
