@@ -118,6 +118,10 @@ pub struct Params {
     /// A REV with fewer finite pixels than this fraction of a full window is NaN.
     #[serde(default = "half")]
     pub min_valid: f64,
+    /// eps_vol (Eq. 5) is NaN where the reference REV holds less solid than this (liquid:
+    /// the ratio g^0/g^n of two near-zero fractions means nothing).
+    #[serde(default = "eps_min_gs")]
+    pub eps_min_gs: f64,
     /// Area of the global `g_S` average (Eq. 1b); the whole image by default.
     #[serde(default)]
     pub global_area: Option<Roi>,
@@ -144,6 +148,9 @@ fn gamma_alcu() -> f64 {
 }
 fn sqrt10() -> f64 {
     10f64.sqrt()
+}
+fn eps_min_gs() -> f64 {
+    0.1
 }
 fn half() -> f64 {
     0.5
@@ -457,14 +464,14 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         }
         let mut eps_json = serde_json::Value::Null;
         let mut eps_tiles = None;
-        let eps = (n > 0).then(|| bl::eps_vol_field(g0_rev.view(), g_rev.view()));
+        let eps = (n > 0).then(|| bl::eps_vol_field(g0_rev.view(), g_rev.view(), p.eps_min_gs));
         if let Some(eps) = &eps {
             let ename = format!("eps_vol_{n:03}");
             tio::write_f32(&out.join(format!("{ename}.tif")), eps.view())?;
             files.push(format!("{ename}.tif").into());
             eps_json = json!(finite_mean(eps));
             let g0t = outs.first().map(|o: &FrameOut| o.gs_tiles.clone()).unwrap_or_default();
-            eps_tiles = Some(bl::eps_vol_field(g0t.view(), gs_tiles.view()));
+            eps_tiles = Some(bl::eps_vol_field(g0t.view(), gs_tiles.view(), p.eps_min_gs));
             if png_frame(n) {
                 let f = format!("{ename}.png");
                 plot::field_png(

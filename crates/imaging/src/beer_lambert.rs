@@ -113,13 +113,14 @@ pub fn eps_vol(g0: f64, gn: f64) -> f64 {
     g0 / gn - 1.0
 }
 
-/// Eq. (5) over two REV maps.
-pub fn eps_vol_field(g0: ArrayView2<f64>, gn: ArrayView2<f64>) -> Array2<f64> {
+/// Eq. (5) over two REV maps. Where the reference REV holds less solid than `min_gs`
+/// (nearly all liquid) the ratio is meaningless (0/0 in pure liquid) and is set to NaN.
+pub fn eps_vol_field(g0: ArrayView2<f64>, gn: ArrayView2<f64>, min_gs: f64) -> Array2<f64> {
     let mut out = Array2::zeros(g0.dim());
     Zip::from(&mut out)
         .and(&g0)
         .and(&gn)
-        .par_for_each(|o, &a, &b| *o = eps_vol(a, b));
+        .par_for_each(|o, &a, &b| *o = if a >= min_gs { eps_vol(a, b) } else { f64::NAN });
     out
 }
 

@@ -96,11 +96,40 @@ impl Displacement {
     }
 }
 
-/// Covered fraction of every pixel of an `h` x `w` image: `ss` x `ss` sample points per
-/// pixel, the union of the disks, then `solid_pads` forced to 1 and `liquid_pads` to 0.
-pub fn coverage(h: usize, w: usize, disks: &[Disk], ss: usize, solid_pads: &[Roi], liquid_pads: &[Roi]) -> Array2<f64> {
+/// How a grain fills the sample thickness along the beam.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GrainShape {
+    /// A cylinder spanning the thickness: `L_S / L = 1` inside the outline (sharp edges).
+    Cylinder,
+    /// A sphere of the outline's radius squeezed between the cell windows (Su et al. 2020
+    /// Fig. 1a: the sample is sandwiched between two windows): `L_S = min(L, 2 sqrt(r^2 - rho^2))`.
+    #[default]
+    TruncatedSphere,
+}
+
+/// Render the true pixel solid fraction `L_S / L` and the expected counts of an `h` x `w`
+/// frame. Each pixel is sampled at `ss` x `ss` points; at each point the solid path is that
+/// of the grain covering it (grains do not overlap; if they do after a displacement the
+/// larger path wins), and the detector averages *intensity* `I0 exp(-mu_S L_S - mu_L (L - L_S))`
+/// over the points, not its logarithm. `thickness_px` is `L` in pixels. `solid_pads` are
+/// 100% solid, `liquid_pads` 100% liquid.
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    h: usize,
+    w: usize,
+    disks: &[Disk],
+    ss: usize,
+    shape: GrainShape,
+    thickness_px: f64,
+    thickness: f64,
+    beam: &Beam,
+    solid_pads: &[Roi],
+    liquid_pads: &[Roi],
+) -> (Array2<f64>, Array2<f64>) {
     let ss = ss.max(1);
-    let mut out = Array2::<f64>::zeros((h, w));
+    let mut frac = Array2::<f64>::zeros((h, w));
+    let mut counts = Array2::<f64>::zeros((h, w));
     // Disks touching each row, so each row is independent (parallel, deterministic).
     let mut by_row: Vec<Vec<usize>> = vec![Vec::new(); h];
     for (i, d) in disks.iter().enumerate() {
@@ -111,41 +140,59 @@ pub fn coverage(h: usize, w: usize, disks: &[Disk], ss: usize, solid_pads: &[Roi
         }
     }
     let inv = 1.0 / (ss * ss) as f64;
-    out.axis_iter_mut(Axis(0)).into_par_iter().enumerate().for_each(|(r, mut orow)| {
-        let mut hits = vec![0u32; w];
-        for sy in 0..ss {
-            let y = r as f64 + (sy as f64 + 0.5) / ss as f64;
-            // Union: mark each sample once, whatever the number of disks covering it.
-            let mut marked = vec![false; w * ss];
-            for &i in &by_row[r] {
-                let d = disks[i];
-                let dy = y - d.y;
-                let h2 = d.r * d.r - dy * dy;
-                if h2 <= 0.0 {
-                    continue;
+    let att = |f: f64| beam.i0 * (-thickness * (beam.mu_s * f + beam.mu_l * (1.0 - f))).exp();
+    frac.axis_iter_mut(Axis(0))
+        .into_par_iter()
+        .zip(counts.axis_iter_mut(Axis(0)).into_par_iter())
+        .enumerate()
+        .for_each(|(r, (mut frow, mut crow))| {
+            let mut fsum = vec![0.0f64; w];
+            let mut isum = vec![0.0f64; w];
+            let mut path = vec![0.0f64; w * ss];
+            for sy in 0..ss {
+                let y = r as f64 + (sy as f64 + 0.5) / ss as f64;
+                path.iter_mut().for_each(|p| *p = 0.0);
+                for &i in &by_row[r] {
+                    let d = disks[i];
+                    let dy = y - d.y;
+                    let h2 = d.r * d.r - dy * dy;
+                    if h2 <= 0.0 {
+                        continue;
+                    }
+                    let half = h2.sqrt();
+                    let s0 = (((d.x - half) * ss as f64) - 0.5).ceil().max(0.0) as usize;
+                    let s1 = ((((d.x + half) * ss as f64) - 0.5).floor() + 1.0).max(0.0) as usize;
+                    for (k, p) in path.iter_mut().enumerate().take(s1.min(w * ss)).skip(s0) {
+                        let f = match shape {
+                            GrainShape::Cylinder => 1.0,
+                            GrainShape::TruncatedSphere => {
+                                let x = (k as f64 + 0.5) / ss as f64;
+                                let rho2 = (x - d.x).powi(2) + dy * dy;
+                                (2.0 * (d.r * d.r - rho2).max(0.0).sqrt() / thickness_px).min(1.0)
+                            }
+                        };
+                        *p = p.max(f);
+                    }
                 }
-                let half = h2.sqrt();
-                let s0 = (((d.x - half) * ss as f64) - 0.5).ceil().max(0.0) as usize;
-                let s1 = ((((d.x + half) * ss as f64) - 0.5).floor() + 1.0).max(0.0) as usize;
-                for m in marked.iter_mut().take(s1.min(w * ss)).skip(s0) {
-                    *m = true;
+                for (c, chunk) in path.chunks(ss).enumerate() {
+                    for &f in chunk {
+                        fsum[c] += f;
+                        isum[c] += att(f);
+                    }
                 }
             }
-            for (c, chunk) in marked.chunks(ss).enumerate() {
-                hits[c] += chunk.iter().filter(|&&b| b).count() as u32;
+            for (c, (fo, co)) in frow.iter_mut().zip(crow.iter_mut()).enumerate() {
+                *fo = fsum[c] * inv;
+                *co = isum[c] * inv;
             }
+        });
+    for (pads, f) in [(solid_pads, 1.0), (liquid_pads, 0.0)] {
+        for p in pads {
+            p.view_mut_fill(&mut frac, f);
+            p.view_mut_fill(&mut counts, att(f));
         }
-        for (o, &n) in orow.iter_mut().zip(&hits) {
-            *o = n as f64 * inv;
-        }
-    });
-    for p in solid_pads {
-        p.view_mut_fill(&mut out, 1.0);
     }
-    for p in liquid_pads {
-        p.view_mut_fill(&mut out, 0.0);
-    }
-    out
+    (frac, counts)
 }
 
 impl Roi {
@@ -165,15 +212,6 @@ pub struct Beam {
     /// Linear attenuation coefficients of solid and liquid, 1/m.
     pub mu_s: f64,
     pub mu_l: f64,
-}
-
-/// Expected counts: each pixel integrates `I0 exp(-mu L)` over its area, so a pixel
-/// with covered fraction `c` gets `I0 (c e^{-mu_S L} + (1 - c) e^{-mu_L L})` (not the
-/// exponential of the mean: the detector averages intensity, not its logarithm).
-pub fn expected_counts(cov: ArrayView2<f64>, thickness: f64, beam: &Beam) -> Array2<f64> {
-    let ts = (-beam.mu_s * thickness).exp();
-    let tl = (-beam.mu_l * thickness).exp();
-    cov.mapv(|c| beam.i0 * (c * ts + (1.0 - c) * tl))
 }
 
 /// Separable Gaussian detector blur of standard deviation `sigma` px (edges clamped).
@@ -235,12 +273,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn coverage_of_a_big_disk_matches_its_area() {
+    fn rendered_solid_volume_matches_geometry() {
         let d = [Disk { x: 50.0, y: 40.0, r: 20.0 }];
-        let c = coverage(100, 100, &d, 8, &[], &[]);
-        let area = c.sum();
+        let beam = Beam { i0: 1.0, mu_s: 1.0, mu_l: 2.0 };
+        let (c, _) = render(100, 100, &d, 8, GrainShape::Cylinder, 30.0, 1e-4, &beam, &[], &[]);
         let exact = std::f64::consts::PI * 400.0;
-        assert!((area - exact).abs() / exact < 2e-3, "{area} vs {exact}");
+        assert!((c.sum() - exact).abs() / exact < 2e-3, "{} vs {exact}", c.sum());
+        // A sphere of radius 20 px in a 30 px thick sample: volume of the sphere minus the two
+        // caps of height 5 px cut off by the windows, over L.
+        let (c, _) = render(100, 100, &d, 8, GrainShape::TruncatedSphere, 30.0, 1e-4, &beam, &[], &[]);
+        let cap = std::f64::consts::PI * 25.0 * (3.0 * 20.0 - 5.0) / 3.0;
+        let vol = 4.0 / 3.0 * std::f64::consts::PI * 8000.0 - 2.0 * cap;
+        assert!((c.sum() - vol / 30.0).abs() / (vol / 30.0) < 3e-3, "{} vs {}", c.sum(), vol / 30.0);
     }
 
     #[test]
