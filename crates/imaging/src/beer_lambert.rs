@@ -113,6 +113,14 @@ pub fn eps_vol(g0: f64, gn: f64) -> f64 {
     g0 / gn - 1.0
 }
 
+/// [`eps_vol_field`] into a preallocated map (same shape as `g0`).
+pub fn eps_vol_into(g0: ArrayView2<f64>, gn: ArrayView2<f64>, min_gs: f64, out: &mut Array2<f64>) {
+    Zip::from(out)
+        .and(&g0)
+        .and(&gn)
+        .par_for_each(|o, &a, &b| *o = if a >= min_gs { eps_vol(a, b) } else { f64::NAN });
+}
+
 /// Eq. (5) over two REV maps. Where the reference REV holds less solid than `min_gs`
 /// (nearly all liquid) the ratio is meaningless (0/0 in pure liquid) and is set to NaN.
 pub fn eps_vol_field(g0: ArrayView2<f64>, gn: ArrayView2<f64>, min_gs: f64) -> Array2<f64> {
