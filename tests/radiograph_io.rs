@@ -1,7 +1,7 @@
 //! TIFF reading: 8-bit, 16-bit, 32-bit float with deflate, multi-page stacks and numbered
 //! frame directories (natural order), round-tripped through the writers.
 
-use lbdem::io::tiff::{read_frames, read_pages, write_f32, write_u16, write_u16_stack, write_u8};
+use lbdem::io::tiff::{read_frames, read_pages, write_f32, write_u8, write_u16, write_u16_stack};
 use ndarray::Array2;
 
 #[test]

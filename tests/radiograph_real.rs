@@ -29,7 +29,9 @@ fn run(dir: &Path, text: &str) -> (serde_json::Value, tempfile::TempDir) {
 
 #[test]
 fn step_wedge_with_dark_flat_dose_and_gamma_spots() {
-    let Some(dir) = real("waterinsand-stepwedge") else { return };
+    let Some(dir) = real("waterinsand-stepwedge") else {
+        return;
+    };
     // "Solid" = empty wedge (I_S^0 over the thin wedge's 0.5 mm step region of frame 0 is
     // meaningless for water; here the references are values so the stage runs end to end).
     let (s, _out) = run(
@@ -52,20 +54,31 @@ fn step_wedge_with_dark_flat_dose_and_gamma_spots() {
         threshold = 6.0"#,
     );
     let f = s["per_frame"].as_array().unwrap();
-    let (d0, d1) = (f[0]["dose_divisor"].as_f64().unwrap(), f[1]["dose_divisor"].as_f64().unwrap());
+    let (d0, d1) = (
+        f[0]["dose_divisor"].as_f64().unwrap(),
+        f[1]["dose_divisor"].as_f64().unwrap(),
+    );
     let (g0, g1) = (
         f[0]["gamma_spots_replaced"].as_u64().unwrap(),
         f[1]["gamma_spots_replaced"].as_u64().unwrap(),
     );
-    println!("dose divisors {d0:.4} {d1:.4}; gamma spots replaced {g0} {g1}; masked {} {}", f[0]["masked_pixels"], f[1]["masked_pixels"]);
+    println!(
+        "dose divisors {d0:.4} {d1:.4}; gamma spots replaced {g0} {g1}; masked {} {}",
+        f[0]["masked_pixels"], f[1]["masked_pixels"]
+    );
     // The README says the frames differ in dose and carry many gamma spots.
-    assert!((d0 - d1).abs() > 0.01, "dose normalisation found no dose difference");
+    assert!(
+        (d0 - d1).abs() > 0.01,
+        "dose normalisation found no dose difference"
+    );
     assert!(g0 > 100 && g1 > 100, "gamma spots not found: {g0} {g1}");
 }
 
 #[test]
 fn wood_pair_float32_deflate_with_nan_masks() {
-    let Some(dir) = real("adic-neutron-wood-swelling") else { return };
+    let Some(dir) = real("adic-neutron-wood-swelling") else {
+        return;
+    };
     // Transmissions already flat-field normalised; pixel size not stated upstream (100 um
     // assumed for the REV only). Reference "phases": earlywood-like and latewood-like levels.
     let (s, out) = run(
@@ -81,10 +94,20 @@ fn wood_pair_float32_deflate_with_nan_masks() {
         plots = false"#,
     );
     let f = s["per_frame"].as_array().unwrap();
-    println!("wood: g_S global {} -> {}, eps_vol mean {}", f[0]["g_s_global"], f[1]["g_s_global"], f[1]["eps_vol_mean"]);
-    let eps = lbdem::io::tiff::read_pages(&out.path().join("eps_vol_001.tif")).unwrap().remove(0).data;
+    println!(
+        "wood: g_S global {} -> {}, eps_vol mean {}",
+        f[0]["g_s_global"], f[1]["g_s_global"], f[1]["eps_vol_mean"]
+    );
+    let eps = lbdem::io::tiff::read_pages(&out.path().join("eps_vol_001.tif"))
+        .unwrap()
+        .remove(0)
+        .data;
     let finite = eps.iter().filter(|v| v.is_finite()).count();
     // NaN-masked pixels of the reference are ignored by the REV averages, not spread.
-    assert!(finite > eps.len() / 2, "only {finite} of {} eps_vol pixels are finite", eps.len());
+    assert!(
+        finite > eps.len() / 2,
+        "only {finite} of {} eps_vol pixels are finite",
+        eps.len()
+    );
     assert!(f[1]["eps_vol_mean"].as_f64().unwrap().is_finite());
 }

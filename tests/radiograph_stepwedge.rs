@@ -13,8 +13,14 @@ use std::path::Path;
 
 /// `shared/` beside the clone (CI), or two levels up for a git worktree under `wt/`.
 const CANDIDATES: [&str; 2] = [
-    concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/real/waterinsand-stepwedge"),
-    concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/real/waterinsand-stepwedge"),
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/data/real/waterinsand-stepwedge"
+    ),
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/data/real/waterinsand-stepwedge"
+    ),
 ];
 
 fn dir() -> Option<&'static Path> {
@@ -43,7 +49,10 @@ pub fn water_attenuation() -> Option<Array2<f64>> {
     let dw = correct::dose_normalise(&mut t_w, OPEN.into()).unwrap();
     println!("dose divisors on the open region: empty {de:.4}, water {dw:.4}");
     let mut a = Array2::zeros(t_e.dim());
-    ndarray::Zip::from(&mut a).and(&t_e).and(&t_w).for_each(|a, &e, &w| *a = -(w / e).ln());
+    ndarray::Zip::from(&mut a)
+        .and(&t_e)
+        .and(&t_w)
+        .for_each(|a, &e, &w| *a = -(w / e).ln());
     Some(a)
 }
 
@@ -59,7 +68,13 @@ fn plateaus(a: &Array2<f64>, x0: usize, x1: usize, jump: f64) -> Vec<(usize, usi
     let mean = |r0: usize, r1: usize| prof[r0..r1].iter().sum::<f64>() / (r1 - r0) as f64;
     let k = 10;
     let step: Vec<f64> = (0..h)
-        .map(|r| if r < k || r + k > h { 0.0 } else { (mean(r, r + k) - mean(r - k, r)).abs() })
+        .map(|r| {
+            if r < k || r + k > h {
+                0.0
+            } else {
+                (mean(r, r + k) - mean(r - k, r)).abs()
+            }
+        })
         .collect();
     // Edge rows: local maxima of the step signal above `jump`.
     let mut edges = vec![0];
@@ -99,9 +114,16 @@ fn thin_wedge_attenuation_is_linear_in_water_thickness() {
     // Thin wedge: x ~ 900-1300 px (README); the central 200 columns avoid its walls.
     let thin = plateaus(&a, 1000, 1200, 0.04);
     println!("thin wedge plateaus (row0, row1, attenuation): {thin:?}");
-    assert_eq!(thin.len(), 5, "expected the 5 steps of the thin wedge, found {thin:?}");
+    assert_eq!(
+        thin.len(),
+        5,
+        "expected the 5 steps of the thin wedge, found {thin:?}"
+    );
     // The thickest step is at the top (README): attenuation must fall with the row.
-    assert!(thin.windows(2).all(|w| w[0].2 > w[1].2), "steps not ordered thick-to-thin from the top");
+    assert!(
+        thin.windows(2).all(|w| w[0].2 > w[1].2),
+        "steps not ordered thick-to-thin from the top"
+    );
     let t_mm = [2.5, 2.0, 1.5, 1.0, 0.5];
     let att: Vec<f64> = thin.iter().map(|p| p.2).collect();
     let fit = linear_fit(&t_mm, &att).unwrap();

@@ -57,7 +57,13 @@ fn max_err(measured: &Array2<f64>, truth: &Array2<f64>) -> f64 {
         .iter()
         .zip(truth)
         .filter(|(_, t)| t.is_finite())
-        .map(|(m, t)| if m.is_finite() { (m - t).abs() } else { f64::INFINITY })
+        .map(|(m, t)| {
+            if m.is_finite() {
+                (m - t).abs()
+            } else {
+                f64::INFINITY
+            }
+        })
         .fold(0.0, f64::max)
 }
 
@@ -65,8 +71,14 @@ fn run(thickness: Thickness, synth_dir: &Path, s: &SParams) -> (f64, f64, f64) {
     let out = tempfile::tempdir().unwrap();
     let ctx = StageContext::new(out.path().into(), "radiograph".into(), synth_dir.into());
     Radiograph::run(&radiograph_params(synth_dir, s, thickness), &ctx).unwrap();
-    let e0 = max_err(&read(&out.path().join("gs_rev_000.tif")), &read(&synth_dir.join("true_gs_rev_000.tif")));
-    let e1 = max_err(&read(&out.path().join("gs_rev_001.tif")), &read(&synth_dir.join("true_gs_rev_001.tif")));
+    let e0 = max_err(
+        &read(&out.path().join("gs_rev_000.tif")),
+        &read(&synth_dir.join("true_gs_rev_000.tif")),
+    );
+    let e1 = max_err(
+        &read(&out.path().join("gs_rev_001.tif")),
+        &read(&synth_dir.join("true_gs_rev_001.tif")),
+    );
     let ee = max_err(
         &read(&out.path().join("eps_vol_001.tif")),
         &read(&synth_dir.join("true_eps_vol_001.tif")),
@@ -90,5 +102,8 @@ fn thickness_corrected_solid_fraction_and_strain_match_truth() {
     // Without the thickness correction the 5% thinner frame is misread.
     let (_, e1, ee) = run(Thickness::None, dir.path(), &s);
     assert!(e1 > 0.03, "uncorrected g_S error {e1} should be well above 0.01");
-    assert!(ee > 0.03, "uncorrected eps_vol error {ee} should be well above 0.005");
+    assert!(
+        ee > 0.03,
+        "uncorrected eps_vol error {ee} should be well above 0.005"
+    );
 }

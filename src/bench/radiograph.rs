@@ -31,7 +31,18 @@ fn frames(n: usize) -> Result<Vec<Array2<u16>>> {
     let mut out = Vec::new();
     for (k, l) in [150e-6, 142.5e-6].into_iter().enumerate() {
         let px = 6e-6 * 1024.0 / n as f64;
-        let (_, counts) = synth::render(n, n, &disks, 1, GrainShape::TruncatedSphere, l / px, l, &beam, &[], &[]);
+        let (_, counts) = synth::render(
+            n,
+            n,
+            &disks,
+            1,
+            GrainShape::TruncatedSphere,
+            l / px,
+            l,
+            &beam,
+            &[],
+            &[],
+        );
         out.push(synth::noisy_u16(counts.view(), 11 + k as u64)?);
     }
     Ok(out)

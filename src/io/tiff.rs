@@ -2,9 +2,9 @@
 //! it marks masked pixels); writing encodes in memory and then writes atomically.
 
 use anyhow::{Context, Result, bail};
+use lbdem_imaging::tiff::ColorType;
 use lbdem_imaging::tiff::decoder::{Decoder, DecodingResult, Limits};
 use lbdem_imaging::tiff::encoder::{Compression, DeflateLevel, TiffEncoder, colortype};
-use lbdem_imaging::tiff::ColorType;
 use ndarray::{Array2, ArrayView2};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
@@ -21,8 +21,12 @@ pub struct Frame {
 
 /// Every TIFF page of `path` (a stack yields several frames).
 pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
-    let file = std::fs::File::open(path)
-        .with_context(|| format!("cannot open TIFF file {} (check the path in 'frames'/'dark'/'flat')", path.display()))?;
+    let file = std::fs::File::open(path).with_context(|| {
+        format!(
+            "cannot open TIFF file {} (check the path in 'frames'/'dark'/'flat')",
+            path.display()
+        )
+    })?;
     let mut dec = Decoder::new(std::io::BufReader::new(file))
         .with_context(|| format!("{} is not a readable TIFF file", path.display()))?
         .with_limits(Limits::unlimited());
@@ -34,8 +38,12 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
         } else {
             format!("{}#{page}", path.display())
         };
-        let (w, h) = dec.dimensions().with_context(|| format!("{label}: cannot read the image size"))?;
-        let ct = dec.colortype().with_context(|| format!("{label}: cannot read the pixel type"))?;
+        let (w, h) = dec
+            .dimensions()
+            .with_context(|| format!("{label}: cannot read the image size"))?;
+        let ct = dec
+            .colortype()
+            .with_context(|| format!("{label}: cannot read the pixel type"))?;
         let bits = match ct {
             ColorType::Gray(b @ (8 | 16 | 32)) => b,
             other => bail!(
@@ -44,7 +52,9 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
                  ImageJ or tifffile) to one of these"
             ),
         };
-        let img = dec.read_image().with_context(|| format!("{label}: cannot decode the pixel data"))?;
+        let img = dec
+            .read_image()
+            .with_context(|| format!("{label}: cannot decode the pixel data"))?;
         let v: Vec<f64> = match img {
             DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
             DecodingResult::U16(v) => v.into_iter().map(f64::from).collect(),
@@ -55,7 +65,8 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
                  or 32-bit float samples",
                 match other {
                     DecodingResult::U32(_) => "32-bit unsigned integer",
-                    DecodingResult::I8(_) | DecodingResult::I16(_) | DecodingResult::I32(_) => "signed integer",
+                    DecodingResult::I8(_) | DecodingResult::I16(_) | DecodingResult::I32(_) =>
+                        "signed integer",
                     _ => "other",
                 }
             ),
@@ -66,7 +77,8 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
         if !dec.more_images() {
             break;
         }
-        dec.next_image().with_context(|| format!("{}: cannot read page {}", path.display(), page + 1))?;
+        dec.next_image()
+            .with_context(|| format!("{}: cannot read page {}", path.display(), page + 1))?;
     }
     Ok(frames)
 }
@@ -89,12 +101,15 @@ pub fn expand_paths(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
             if v.is_empty() {
                 bail!("frame directory {} holds no .tif/.tiff files", p.display());
             }
-            v.sort_by(|a, b| natural_key(a).cmp(&natural_key(b)));
+            v.sort_by_key(|a| natural_key(a));
             out.extend(v);
         } else if p.is_file() {
             out.push(p.clone());
         } else {
-            bail!("frame file {} does not exist (check 'frames' in the parameters)", p.display());
+            bail!(
+                "frame file {} does not exist (check 'frames' in the parameters)",
+                p.display()
+            );
         }
     }
     Ok(out)
@@ -102,7 +117,10 @@ pub fn expand_paths(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 
 /// Sort key splitting digit runs out as numbers.
 fn natural_key(p: &Path) -> Vec<(String, u64)> {
-    let name = p.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = p
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let mut key = Vec::new();
     let mut text = String::new();
     let mut num = String::new();
@@ -160,7 +178,8 @@ pub fn write_f32(path: &Path, f: ArrayView2<f64>) -> Result<()> {
         .with_compression(Compression::Deflate(DeflateLevel::Fast))
         .write_image::<colortype::Gray32Float>(w, h, &v)
         .with_context(|| format!("cannot encode {}", path.display()))?;
-    lbdem_core::atomic::write_atomic(path, buf.get_ref()).with_context(|| format!("cannot write {}", path.display()))
+    lbdem_core::atomic::write_atomic(path, buf.get_ref())
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// 16-bit unsigned TIFF, deflate-compressed, written atomically.
@@ -172,7 +191,8 @@ pub fn write_u16(path: &Path, f: ArrayView2<u16>) -> Result<()> {
         .with_compression(Compression::Deflate(DeflateLevel::Balanced))
         .write_image::<colortype::Gray16>(u32::try_from(w)?, u32::try_from(h)?, &v)
         .with_context(|| format!("cannot encode {}", path.display()))?;
-    lbdem_core::atomic::write_atomic(path, buf.get_ref()).with_context(|| format!("cannot write {}", path.display()))
+    lbdem_core::atomic::write_atomic(path, buf.get_ref())
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Multi-page 16-bit stack (uncompressed), for tests and synthetic stacks.
@@ -184,8 +204,8 @@ pub fn write_u16_stack(path: &Path, frames: &[ArrayView2<u16>]) -> Result<()> {
         let v: Vec<u16> = f.iter().copied().collect();
         enc.write_image::<colortype::Gray16>(u32::try_from(w)?, u32::try_from(h)?, &v)?;
     }
-    drop(enc);
-    lbdem_core::atomic::write_atomic(path, buf.get_ref()).with_context(|| format!("cannot write {}", path.display()))
+    lbdem_core::atomic::write_atomic(path, buf.get_ref())
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// 8-bit TIFF (tests of the reader).
@@ -194,5 +214,6 @@ pub fn write_u8(path: &Path, f: ArrayView2<u8>) -> Result<()> {
     let v: Vec<u8> = f.iter().copied().collect();
     let mut buf = Cursor::new(Vec::new());
     TiffEncoder::new(&mut buf)?.write_image::<colortype::Gray8>(u32::try_from(w)?, u32::try_from(h)?, &v)?;
-    lbdem_core::atomic::write_atomic(path, buf.get_ref()).with_context(|| format!("cannot write {}", path.display()))
+    lbdem_core::atomic::write_atomic(path, buf.get_ref())
+        .with_context(|| format!("cannot write {}", path.display()))
 }

@@ -225,7 +225,10 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
         bail!("parameter 'min_valid' = {} must be in (0, 1]", p.min_valid);
     }
     if p.mu_s == p.mu_l {
-        bail!("parameters 'mu_s' and 'mu_l' are both {}: with no contrast no solid fraction can be measured", p.mu_s);
+        bail!(
+            "parameters 'mu_s' and 'mu_l' are both {}: with no contrast no solid fraction can be measured",
+            p.mu_s
+        );
     }
     if p.frames.is_empty() {
         bail!("parameter 'frames' is empty: list at least one TIFF file, stack or directory");
@@ -233,7 +236,10 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
     one_of("i_l0", p.i_l0, p.i_l0_roi)?;
     one_of("i_s0", p.i_s0, p.i_s0_roi)?;
     if p.thickness != Thickness::None && p.thickness_roi.is_none() {
-        bail!("thickness = \"{:?}\" needs 'thickness_roi' = [x, y, w, h]", p.thickness);
+        bail!(
+            "thickness = \"{:?}\" needs 'thickness_roi' = [x, y, w, h]",
+            p.thickness
+        );
     }
 
     let paths: Vec<PathBuf> = p.frames.iter().map(|f| ctx.resolve(f)).collect();
@@ -292,7 +298,8 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
         rois.push(("profiles.roi", pr.roi));
     }
     for (name, r) in &rois {
-        r.check(name, shape).map_err(|e| anyhow::anyhow!("parameter '{name}': {e}"))?;
+        r.check(name, shape)
+            .map_err(|e| anyhow::anyhow!("parameter '{name}': {e}"))?;
     }
     if let Some(ls) = &p.line_scan {
         if ls.x >= shape.1 || ls.y0 + 3 > ls.y1 || ls.y1 > shape.0 {
@@ -329,7 +336,11 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
         if let Some(g) = &p.gamma_spots {
             (raw, n_g) = correct::remove_gamma_spots(raw.view(), g.size, g.threshold)?;
         }
-        let mut i = correct::flat_dark(raw.view(), dark.as_ref().map(|d| d.view()), flat.as_ref().map(|d| d.view()));
+        let mut i = correct::flat_dark(
+            raw.view(),
+            dark.as_ref().map(|d| d.view()),
+            flat.as_ref().map(|d| d.view()),
+        );
         let d = match p.open_roi {
             Some(r) => correct::dose_normalise(&mut i, r).with_context(|| format!("frame {}", f.label))?,
             None => 1.0,
@@ -416,15 +427,21 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
 
 /// Mean of the finite values.
 fn finite_mean(a: &Array2<f64>) -> f64 {
-    let (s, n) = a.iter().filter(|v| v.is_finite()).fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    let (s, n) = a
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     if n == 0 { f64::NAN } else { s / n as f64 }
 }
+
+/// One profile of one frame: positions (px), REV g_S, and eps_vol (frames n >= 1).
+type ProfileOut = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
 
 /// Per-frame results kept for the tables.
 struct FrameOut {
     gs_tiles: Array2<f64>,
     eps_tiles: Option<Array2<f64>>,
-    profiles: Vec<(Vec<f64>, Vec<f64>, Option<Vec<f64>>)>,
+    profiles: Vec<ProfileOut>,
 }
 
 fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageOutput> {
@@ -470,7 +487,10 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
             tio::write_f32(&out.join(format!("{ename}.tif")), eps.view())?;
             files.push(format!("{ename}.tif").into());
             eps_json = json!(finite_mean(eps));
-            let g0t = outs.first().map(|o: &FrameOut| o.gs_tiles.clone()).unwrap_or_default();
+            let g0t = outs
+                .first()
+                .map(|o: &FrameOut| o.gs_tiles.clone())
+                .unwrap_or_default();
             eps_tiles = Some(bl::eps_vol_field(g0t.view(), gs_tiles.view(), p.eps_min_gs));
             if png_frame(n) {
                 let f = format!("{ename}.png");
@@ -555,8 +575,14 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
     let (th, tw) = outs[0].gs_tiles.dim();
     let side = pr.rev_side as f64;
     let mut cols: Vec<(String, Vec<f64>)> = vec![
-        ("x_mm".into(), (0..th * tw).map(|k| mm(((k % tw) as f64 + 0.5) * side)).collect()),
-        ("y_mm".into(), (0..th * tw).map(|k| mm(((k / tw) as f64 + 0.5) * side)).collect()),
+        (
+            "x_mm".into(),
+            (0..th * tw).map(|k| mm(((k % tw) as f64 + 0.5) * side)).collect(),
+        ),
+        (
+            "y_mm".into(),
+            (0..th * tw).map(|k| mm(((k / tw) as f64 + 0.5) * side)).collect(),
+        ),
     ];
     for (n, o) in outs.iter().enumerate() {
         cols.push((format!("g_s_{n:03}"), o.gs_tiles.iter().copied().collect()));
@@ -632,7 +658,10 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
                 )?;
                 figures.push(Figure {
                     path: f.clone().into(),
-                    caption: format!("{label} along {axis} in profile ROI '{}', every frame.", spec.name),
+                    caption: format!(
+                        "{label} along {axis} in profile ROI '{}', every frame.",
+                        spec.name
+                    ),
                 });
                 files.push(f.into());
             }
@@ -658,7 +687,10 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
             }
             cols.push((format!("z_top_um_{n:03}"), l.iter().map(|v| 0.5e6 * v).collect()));
             cols.push((format!("l_alloy_um_{n:03}"), l.iter().map(|v| 1e6 * v).collect()));
-            series.push((format!("frame {n}"), l.iter().map(|v| 0.5e6 * v).collect::<Vec<f64>>()));
+            series.push((
+                format!("frame {n}"),
+                l.iter().map(|v| 0.5e6 * v).collect::<Vec<f64>>(),
+            ));
         }
         write_table(out, "line_scan.csv", &cols)?;
         files.push("line_scan.csv".into());

@@ -17,10 +17,10 @@ use super::{Figure, Stage, StageContext, StageOutput};
 use crate::io::tiff as tio;
 use crate::report::{plot, table};
 use anyhow::{Context, Result, bail};
+use lbdem_imaging::Roi;
 use lbdem_imaging::beer_lambert::{self as bl, mixture_mu};
 use lbdem_imaging::rev::{self, Sat};
 use lbdem_imaging::synth::{self, Beam, Displacement, GrainShape};
-use lbdem_imaging::Roi;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -239,11 +239,16 @@ impl Params {
     /// `(mu_S, mu_L)` in 1/m: overrides, else NIST mass attenuation mixed by weight.
     pub fn mus(&self) -> (f64, f64) {
         let mu = |rho: f64, w_cu: f64| {
-            mixture_mu(rho, &[(1.0 - w_cu, self.mass_atten_al), (w_cu, self.mass_atten_cu)])
+            mixture_mu(
+                rho,
+                &[(1.0 - w_cu, self.mass_atten_al), (w_cu, self.mass_atten_cu)],
+            )
         };
         (
-            self.mu_s.unwrap_or_else(|| mu(self.solid_density, self.solid_cu_wt)),
-            self.mu_l.unwrap_or_else(|| mu(self.liquid_density, self.liquid_cu_wt)),
+            self.mu_s
+                .unwrap_or_else(|| mu(self.solid_density, self.solid_cu_wt)),
+            self.mu_l
+                .unwrap_or_else(|| mu(self.liquid_density, self.liquid_cu_wt)),
         )
     }
 }
@@ -267,10 +272,16 @@ impl Stage for SynthRadiograph {
             }
         }
         if p.frames < 2 {
-            bail!("parameter 'frames' = {} must be at least 2 (a reference and a deformed frame)", p.frames);
+            bail!(
+                "parameter 'frames' = {} must be at least 2 (a reference and a deformed frame)",
+                p.frames
+            );
         }
         if !(p.thickness_change > -0.9 && p.thickness_change < 1.0) {
-            bail!("parameter 'thickness_change' = {} must be in (-0.9, 1)", p.thickness_change);
+            bail!(
+                "parameter 'thickness_change' = {} must be in (-0.9, 1)",
+                p.thickness_change
+            );
         }
         if p.i0 > 65535.0 {
             bail!("parameter 'i0' = {} exceeds the 16-bit range 65535", p.i0);
@@ -280,7 +291,11 @@ impl Stage for SynthRadiograph {
         let beam = Beam { i0: p.i0, mu_s, mu_l };
         let rev_side = rev::rev_side_px(p.rev_factor, p.d_bar, p.pixel_size)?;
         if rev_side > p.width.min(p.height) {
-            bail!("REV side {rev_side} px is larger than the {}x{} image", p.width, p.height);
+            bail!(
+                "REV side {rev_side} px is larger than the {}x{} image",
+                p.width,
+                p.height
+            );
         }
         let d_px = p.d_bar / p.pixel_size;
         let disks0 = synth::pack_disks(lay.assembly, d_px, p.spread, p.target_fraction, p.seed)?;

@@ -80,14 +80,26 @@ fn check_positive(name: &str, v: f64) -> Result<()> {
     if v > 0.0 && v.is_finite() {
         Ok(())
     } else {
-        Err(ImagingError::invalid(name, v, "must be a positive, finite intensity"))
+        Err(ImagingError::invalid(
+            name,
+            v,
+            "must be a positive, finite intensity",
+        ))
     }
 }
 
 /// Eq. (2): `L^n = L^0 + ln(I_SL.min^0 / I_SL.min^n) / mu_L + (mu_L - mu_S)(L_S.min^n - L_S.min^0) / mu_L`.
 /// With the defaults `ls_min_n = ls_min_0` (a negligibly deformed region) or both 0 (a
 /// fully liquid region) the last term vanishes.
-pub fn thickness_eq2(l0: f64, mu_s: f64, mu_l: f64, i_min0: f64, i_min_n: f64, ls_min0: f64, ls_min_n: f64) -> f64 {
+pub fn thickness_eq2(
+    l0: f64,
+    mu_s: f64,
+    mu_l: f64,
+    i_min0: f64,
+    i_min_n: f64,
+    ls_min0: f64,
+    ls_min_n: f64,
+) -> f64 {
     l0 + (i_min0 / i_min_n).ln() / mu_l + (mu_l - mu_s) * (ls_min_n - ls_min0) / mu_l
 }
 
@@ -168,6 +180,9 @@ mod tests {
 
     #[test]
     fn equal_references_are_refused() {
-        assert!(matches!(FractionMap::eq1(0.5, 0.5), Err(ImagingError::EqualReferences { .. })));
+        assert!(matches!(
+            FractionMap::eq1(0.5, 0.5),
+            Err(ImagingError::EqualReferences { .. })
+        ));
     }
 }

@@ -29,9 +29,7 @@ pub enum ImagingError {
         img_w: usize,
         img_h: usize,
     },
-    #[error(
-        "ROI '{name}' has no finite pixels (all masked/NaN); move it onto valid pixels"
-    )]
+    #[error("ROI '{name}' has no finite pixels (all masked/NaN); move it onto valid pixels")]
     RoiEmpty { name: String },
     #[error(
         "reference intensities I_S^0 = {i_s} and I_L^0 = {i_l} are equal (or within 1e-9 in ln): \

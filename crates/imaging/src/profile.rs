@@ -17,7 +17,12 @@ pub enum ProfileAxis {
 }
 
 /// Mean of the finite pixels of `roi` at each position along `axis`: (pixel centres, means).
-pub fn roi_profile(f: ArrayView2<f64>, roi: Roi, axis: ProfileAxis, name: &str) -> Result<(Vec<f64>, Vec<f64>)> {
+pub fn roi_profile(
+    f: ArrayView2<f64>,
+    roi: Roi,
+    axis: ProfileAxis,
+    name: &str,
+) -> Result<(Vec<f64>, Vec<f64>)> {
     roi.check(name, f.dim())?;
     let v = roi.view(f);
     let (lanes, offset) = match axis {
@@ -50,7 +55,11 @@ pub struct LinearFit {
 
 pub fn linear_fit(x: &[f64], y: &[f64]) -> Result<LinearFit> {
     if x.len() != y.len() || x.len() < 2 {
-        return Err(ImagingError::invalid("fit points", x.len(), "need at least two (x, y) pairs of equal length"));
+        return Err(ImagingError::invalid(
+            "fit points",
+            x.len(),
+            "need at least two (x, y) pairs of equal length",
+        ));
     }
     let n = x.len() as f64;
     let mx = x.iter().sum::<f64>() / n;
@@ -60,7 +69,11 @@ pub fn linear_fit(x: &[f64], y: &[f64]) -> Result<LinearFit> {
     let syy: f64 = y.iter().map(|b| (b - my).powi(2)).sum();
     let slope = sxy / sxx;
     let intercept = my - slope * mx;
-    let ss_res: f64 = x.iter().zip(y).map(|(a, b)| (b - slope * a - intercept).powi(2)).sum();
+    let ss_res: f64 = x
+        .iter()
+        .zip(y)
+        .map(|(a, b)| (b - slope * a - intercept).powi(2))
+        .sum();
     Ok(LinearFit {
         slope,
         intercept,
@@ -71,7 +84,11 @@ pub fn linear_fit(x: &[f64], y: &[f64]) -> Result<LinearFit> {
 /// Least-squares parabola `y = c0 + c1 (x - x0) + c2 (x - x0)^2` (centred for conditioning).
 pub fn quadratic_fit(x: &[f64], y: &[f64], x0: f64) -> Result<[f64; 3]> {
     if x.len() != y.len() || x.len() < 3 {
-        return Err(ImagingError::invalid("fit points", x.len(), "need at least three (x, y) pairs"));
+        return Err(ImagingError::invalid(
+            "fit points",
+            x.len(),
+            "need at least three (x, y) pairs",
+        ));
     }
     let mut m = [[0.0f64; 4]; 3];
     for (&xi, &yi) in x.iter().zip(y) {
@@ -86,16 +103,23 @@ pub fn quadratic_fit(x: &[f64], y: &[f64], x0: f64) -> Result<[f64; 3]> {
     }
     // Gaussian elimination with partial pivoting on the 3x4 augmented matrix.
     for col in 0..3 {
-        let piv = (col..3).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs())).unwrap_or(col);
+        let piv = (col..3)
+            .max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))
+            .unwrap_or(col);
         m.swap(col, piv);
         if m[col][col].abs() < 1e-300 {
-            return Err(ImagingError::invalid("fit points", x.len(), "are degenerate (all at one x)"));
+            return Err(ImagingError::invalid(
+                "fit points",
+                x.len(),
+                "are degenerate (all at one x)",
+            ));
         }
         for r in 0..3 {
             if r != col {
                 let f = m[r][col] / m[col][col];
-                for k in col..4 {
-                    m[r][k] -= f * m[col][k];
+                let pivot_row = m[col];
+                for (x, p) in m[r].iter_mut().zip(pivot_row).skip(col) {
+                    *x -= f * p;
                 }
             }
         }
@@ -132,7 +156,7 @@ pub fn meniscus_fit(y: &[f64], l: &[f64], half_width: f64, gamma: f64) -> Result
         .map(|(a, b)| (*a, *b))
         .unzip();
     let c = quadratic_fit(&xs, &ys, y0)?;
-    if !(c[2] > 0.0) {
+    if c[2].is_nan() || c[2] <= 0.0 {
         return Err(ImagingError::invalid(
             "line_scan.fit_half_width",
             half_width,
@@ -159,7 +183,9 @@ mod tests {
         let x = [0.0, 1.0, 2.0, 3.0];
         let y = [1.0, 3.0, 5.0, 7.0];
         let f = linear_fit(&x, &y).unwrap();
-        assert!((f.slope - 2.0).abs() < 1e-12 && (f.intercept - 1.0).abs() < 1e-12 && (f.r2 - 1.0).abs() < 1e-12);
+        assert!(
+            (f.slope - 2.0).abs() < 1e-12 && (f.intercept - 1.0).abs() < 1e-12 && (f.r2 - 1.0).abs() < 1e-12
+        );
     }
 
     /// Su et al. (2020) Sect. 4.4: R ~ 100 um with gamma ~ 0.7 J/m^2 gives dp ~ -14.00 kPa (Eq. 23).
@@ -168,7 +194,10 @@ mod tests {
         let (r, lmin) = (100e-6, 140e-6);
         let y: Vec<f64> = (-200..=200).map(|i| i as f64 * 0.5e-6).collect();
         // Both faces are circular arcs of radius R: L = L_min + 2 (R - sqrt(R^2 - y^2)).
-        let l: Vec<f64> = y.iter().map(|y| lmin + 2.0 * (r - (r * r - y * y).max(0.0).sqrt())).collect();
+        let l: Vec<f64> = y
+            .iter()
+            .map(|y| lmin + 2.0 * (r - (r * r - y * y).max(0.0).sqrt()))
+            .collect();
         let f = meniscus_fit(&y, &l, 15e-6, 0.7).unwrap();
         // z = L/2 is one face: its radius is R.
         assert!((f.radius - r).abs() / r < 0.02, "R = {}", f.radius);

@@ -114,21 +114,26 @@ impl Sat {
     /// Running sum down each column, in fixed column strips.
     fn column_pass(&mut self) {
         let h1 = self.s.nrows();
-        self.s.axis_chunks_iter_mut(Axis(1), COL_STRIP).into_par_iter().for_each(|mut strip| {
-            for r in 1..h1 {
-                let (prev, mut cur) = strip.view_mut().split_at(Axis(0), r);
-                let prev = prev.row(r - 1);
-                cur.row_mut(0).zip_mut_with(&prev, |c, &p| *c += p);
-            }
-        });
-        if let Some(cnt) = &mut self.count {
-            cnt.axis_chunks_iter_mut(Axis(1), COL_STRIP).into_par_iter().for_each(|mut strip| {
+        self.s
+            .axis_chunks_iter_mut(Axis(1), COL_STRIP)
+            .into_par_iter()
+            .for_each(|mut strip| {
                 for r in 1..h1 {
                     let (prev, mut cur) = strip.view_mut().split_at(Axis(0), r);
                     let prev = prev.row(r - 1);
                     cur.row_mut(0).zip_mut_with(&prev, |c, &p| *c += p);
                 }
             });
+        if let Some(cnt) = &mut self.count {
+            cnt.axis_chunks_iter_mut(Axis(1), COL_STRIP)
+                .into_par_iter()
+                .for_each(|mut strip| {
+                    for r in 1..h1 {
+                        let (prev, mut cur) = strip.view_mut().split_at(Axis(0), r);
+                        let prev = prev.row(r - 1);
+                        cur.row_mut(0).zip_mut_with(&prev, |c, &p| *c += p);
+                    }
+                });
         }
     }
 
@@ -167,41 +172,46 @@ impl Sat {
         // Columns whose window is not clipped: c - lo >= 0 and c + hi <= w.
         let (ci0, ci1) = (lo, (w + 1).saturating_sub(hi).max(lo));
         let fast = self.count.is_none() && self.s.is_standard_layout();
-        out.axis_iter_mut(Axis(0)).into_par_iter().enumerate().for_each(|(r, mut orow)| {
-            let r0 = r.saturating_sub(lo);
-            let r1 = (r + hi).min(h);
-            let slow = |c: usize| {
-                let c0 = c.saturating_sub(lo);
-                let c1 = (c + hi).min(w);
-                let (s, n) = self.window(r0, c0, r1, c1);
-                if n >= need { s / n as f64 } else { f64::NAN }
-            };
-            let (Some(orow_s), true) = (orow.as_slice_mut(), fast) else {
-                for (c, o) in orow.iter_mut().enumerate() {
-                    *o = slow(c);
+        out.axis_iter_mut(Axis(0))
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(r, mut orow)| {
+                let r0 = r.saturating_sub(lo);
+                let r1 = (r + hi).min(h);
+                let slow = |c: usize| {
+                    let c0 = c.saturating_sub(lo);
+                    let c1 = (c + hi).min(w);
+                    let (s, n) = self.window(r0, c0, r1, c1);
+                    if n >= need { s / n as f64 } else { f64::NAN }
+                };
+                let (Some(orow_s), true) = (orow.as_slice_mut(), fast) else {
+                    for (c, o) in orow.iter_mut().enumerate() {
+                        *o = slow(c);
+                    }
+                    return;
+                };
+                let n = (r1 - r0) * side;
+                let top = self.s.row(r0).to_slice().expect("standard layout");
+                let bot = self.s.row(r1).to_slice().expect("standard layout");
+                if n >= need && ci1 > ci0 {
+                    let inv = 1.0 / n as f64;
+                    let len = ci1 - ci0;
+                    let (tl, bl_) = (&top[..len], &bot[..len]);
+                    let (tr, br) = (&top[side..side + len], &bot[side..side + len]);
+                    for ((((o, &a), &b), &c), &d) in
+                        orow_s[ci0..ci1].iter_mut().zip(br).zip(tr).zip(bl_).zip(tl)
+                    {
+                        *o = (a - b - c + d) * inv;
+                    }
+                } else {
+                    for (c, o) in orow_s.iter_mut().enumerate().take(ci1).skip(ci0) {
+                        *o = slow(c);
+                    }
                 }
-                return;
-            };
-            let n = (r1 - r0) * side;
-            let top = self.s.row(r0).to_slice().expect("standard layout");
-            let bot = self.s.row(r1).to_slice().expect("standard layout");
-            if n >= need && ci1 > ci0 {
-                let inv = 1.0 / n as f64;
-                let len = ci1 - ci0;
-                let (tl, bl_) = (&top[..len], &bot[..len]);
-                let (tr, br) = (&top[side..side + len], &bot[side..side + len]);
-                for ((((o, &a), &b), &c), &d) in orow_s[ci0..ci1].iter_mut().zip(br).zip(tr).zip(bl_).zip(tl) {
-                    *o = (a - b - c + d) * inv;
+                for c in (0..ci0).chain(ci1..w) {
+                    orow_s[c] = slow(c);
                 }
-            } else {
-                for (c, o) in orow_s.iter_mut().enumerate().take(ci1).skip(ci0) {
-                    *o = slow(c);
-                }
-            }
-            for c in (0..ci0).chain(ci1..w) {
-                orow_s[c] = slow(c);
-            }
-        });
+            });
         Ok(())
     }
 
@@ -238,9 +248,17 @@ fn check_side(side: usize, h: usize, w: usize) -> Result<()> {
 /// REV side in pixels: `rev_factor * d_bar / pixel_size` rounded (Su et al. 2020 take
 /// `rev_factor = sqrt(10)`), at least 1.
 pub fn rev_side_px(rev_factor: f64, d_bar: f64, pixel_size: f64) -> Result<usize> {
-    for (n, v) in [("rev_factor", rev_factor), ("d_bar", d_bar), ("pixel_size", pixel_size)] {
+    for (n, v) in [
+        ("rev_factor", rev_factor),
+        ("d_bar", d_bar),
+        ("pixel_size", pixel_size),
+    ] {
         if !(v > 0.0 && v.is_finite()) {
-            return Err(ImagingError::invalid(n, v, "must be positive and finite (SI units: metres)"));
+            return Err(ImagingError::invalid(
+                n,
+                v,
+                "must be positive and finite (SI units: metres)",
+            ));
         }
     }
     Ok(((rev_factor * d_bar / pixel_size).round() as usize).max(1))
@@ -297,7 +315,10 @@ mod tests {
             let fast = sat.rev_mean(side, 0.5).unwrap();
             let slow = rev_mean_naive(f.view(), side, 0.5);
             for (a, b) in fast.iter().zip(&slow) {
-                assert!((a.is_nan() && b.is_nan()) || (a - b).abs() < 1e-9, "side {side}: {a} vs {b}");
+                assert!(
+                    (a.is_nan() && b.is_nan()) || (a - b).abs() < 1e-9,
+                    "side {side}: {a} vs {b}"
+                );
             }
         }
     }
@@ -307,6 +328,9 @@ mod tests {
         let f = Array2::<f64>::zeros((10, 20));
         let mut sat = Sat::new();
         sat.build(f.view());
-        assert!(matches!(sat.rev_mean(11, 0.5), Err(ImagingError::RevTooLarge { side_px: 11, .. })));
+        assert!(matches!(
+            sat.rev_mean(11, 0.5),
+            Err(ImagingError::RevTooLarge { side_px: 11, .. })
+        ));
     }
 }

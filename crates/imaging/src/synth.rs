@@ -28,7 +28,7 @@ pub struct Disk {
 /// `d_mean (1 +- spread)` inside `region`, until the disk area reaches `target` of the
 /// region or `max_attempts` placements fail in a row.
 pub fn pack_disks(region: Roi, d_mean: f64, spread: f64, target: f64, seed: u64) -> Result<Vec<Disk>> {
-    if !(d_mean > 1.0) || d_mean > region.w.min(region.h) as f64 {
+    if d_mean.is_nan() || d_mean <= 1.0 || d_mean > region.w.min(region.h) as f64 {
         return Err(ImagingError::invalid(
             "d_mean_px",
             d_mean,
@@ -51,7 +51,10 @@ pub fn pack_disks(region: Roi, d_mean: f64, spread: f64, target: f64, seed: u64)
         let r = 0.5 * d;
         let x = region.x as f64 + r + rng.random::<f64>() * (region.w as f64 - d);
         let y = region.y as f64 + r + rng.random::<f64>() * (region.h as f64 - d);
-        if disks.iter().any(|o| (o.x - x).powi(2) + (o.y - y).powi(2) < (o.r + r).powi(2)) {
+        if disks
+            .iter()
+            .any(|o| (o.x - x).powi(2) + (o.y - y).powi(2) < (o.r + r).powi(2))
+        {
             fails += 1;
             continue;
         }
@@ -199,8 +202,11 @@ impl Roi {
     /// Fill the ROI (clipped to the array) with `v`.
     pub fn view_mut_fill(&self, a: &mut Array2<f64>, v: f64) {
         let (h, w) = a.dim();
-        a.slice_mut(ndarray::s![self.y.min(h)..(self.y + self.h).min(h), self.x.min(w)..(self.x + self.w).min(w)])
-            .fill(v);
+        a.slice_mut(ndarray::s![
+            self.y.min(h)..(self.y + self.h).min(h),
+            self.x.min(w)..(self.x + self.w).min(w)
+        ])
+        .fill(v);
     }
 }
 
@@ -216,26 +222,31 @@ pub struct Beam {
 
 /// Separable Gaussian detector blur of standard deviation `sigma` px (edges clamped).
 pub fn gaussian_blur(f: ArrayView2<f64>, sigma: f64) -> Array2<f64> {
-    if !(sigma > 0.0) {
+    if sigma.is_nan() || sigma <= 0.0 {
         return f.to_owned();
     }
     let k = (3.0 * sigma).ceil() as isize;
-    let mut w: Vec<f64> = (-k..=k).map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp()).collect();
+    let mut w: Vec<f64> = (-k..=k)
+        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp())
+        .collect();
     let s: f64 = w.iter().sum();
     w.iter_mut().for_each(|v| *v /= s);
     let (h, wd) = f.dim();
     let pass = |src: ArrayView2<f64>, n: usize| -> Array2<f64> {
         let mut out = Array2::zeros(src.dim());
-        out.axis_iter_mut(Axis(0)).into_par_iter().zip(src.axis_iter(Axis(0))).for_each(|(mut o, s)| {
-            for (j, ov) in o.iter_mut().enumerate() {
-                let mut acc = 0.0;
-                for (t, wt) in w.iter().enumerate() {
-                    let jj = (j as isize + t as isize - k).clamp(0, n as isize - 1) as usize;
-                    acc += wt * s[jj];
+        out.axis_iter_mut(Axis(0))
+            .into_par_iter()
+            .zip(src.axis_iter(Axis(0)))
+            .for_each(|(mut o, s)| {
+                for (j, ov) in o.iter_mut().enumerate() {
+                    let mut acc = 0.0;
+                    for (t, wt) in w.iter().enumerate() {
+                        let jj = (j as isize + t as isize - k).clamp(0, n as isize - 1) as usize;
+                        acc += wt * s[jj];
+                    }
+                    *ov = acc;
                 }
-                *ov = acc;
-            }
-        });
+            });
         out
     };
     let rows = pass(f, wd);
@@ -247,7 +258,11 @@ pub fn gaussian_blur(f: ArrayView2<f64>, sigma: f64) -> Array2<f64> {
 /// is zero), one random stream per row derived from `seed`.
 pub fn noisy_u16(expected: ArrayView2<f64>, seed: u64) -> Result<Array2<u16>> {
     if let Some(v) = expected.iter().find(|v| !(**v >= 0.0 && v.is_finite())) {
-        return Err(ImagingError::invalid("expected counts", v, "must be finite and >= 0"));
+        return Err(ImagingError::invalid(
+            "expected counts",
+            v,
+            "must be finite and >= 0",
+        ));
     }
     let mut out = Array2::<u16>::zeros(expected.dim());
     out.axis_iter_mut(Axis(0))
@@ -255,7 +270,8 @@ pub fn noisy_u16(expected: ArrayView2<f64>, seed: u64) -> Result<Array2<u16>> {
         .zip(expected.axis_iter(Axis(0)))
         .enumerate()
         .for_each(|(r, (mut o, e))| {
-            let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ (r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+            let mut rng =
+                Xoshiro256PlusPlus::seed_from_u64(seed ^ (r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
             for (ov, &lam) in o.iter_mut().zip(e) {
                 let n = if lam > 0.0 {
                     Poisson::new(lam).map(|p| p.sample(&mut rng)).unwrap_or(lam)
@@ -274,17 +290,41 @@ mod tests {
 
     #[test]
     fn rendered_solid_volume_matches_geometry() {
-        let d = [Disk { x: 50.0, y: 40.0, r: 20.0 }];
-        let beam = Beam { i0: 1.0, mu_s: 1.0, mu_l: 2.0 };
+        let d = [Disk {
+            x: 50.0,
+            y: 40.0,
+            r: 20.0,
+        }];
+        let beam = Beam {
+            i0: 1.0,
+            mu_s: 1.0,
+            mu_l: 2.0,
+        };
         let (c, _) = render(100, 100, &d, 8, GrainShape::Cylinder, 30.0, 1e-4, &beam, &[], &[]);
         let exact = std::f64::consts::PI * 400.0;
         assert!((c.sum() - exact).abs() / exact < 2e-3, "{} vs {exact}", c.sum());
         // A sphere of radius 20 px in a 30 px thick sample: volume of the sphere minus the two
         // caps of height 5 px cut off by the windows, over L.
-        let (c, _) = render(100, 100, &d, 8, GrainShape::TruncatedSphere, 30.0, 1e-4, &beam, &[], &[]);
+        let (c, _) = render(
+            100,
+            100,
+            &d,
+            8,
+            GrainShape::TruncatedSphere,
+            30.0,
+            1e-4,
+            &beam,
+            &[],
+            &[],
+        );
         let cap = std::f64::consts::PI * 25.0 * (3.0 * 20.0 - 5.0) / 3.0;
         let vol = 4.0 / 3.0 * std::f64::consts::PI * 8000.0 - 2.0 * cap;
-        assert!((c.sum() - vol / 30.0).abs() / (vol / 30.0) < 3e-3, "{} vs {}", c.sum(), vol / 30.0);
+        assert!(
+            (c.sum() - vol / 30.0).abs() / (vol / 30.0) < 3e-3,
+            "{} vs {}",
+            c.sum(),
+            vol / 30.0
+        );
     }
 
     #[test]
