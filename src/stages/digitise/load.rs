@@ -1,0 +1,88 @@
+//! Reading the image digitise works on: a 32- or 64-bit float TIFF (the radiograph
+//! stage's solid-fraction map, values 0..1, NaN outside the sample) through the `tiff`
+//! crate, anything else (PNG, JPEG, 8/16-bit TIFF) through `image`, reduced to one grey
+//! channel in f64.
+
+use anyhow::{Context, Result, bail};
+use ndarray::Array2;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Which grey value a colour image gives.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Channel {
+    /// Rec. 601 luma 0.299 R + 0.587 G + 0.114 B.
+    #[default]
+    Luma,
+    Red,
+    Green,
+    Blue,
+}
+
+/// The grey image and what it was.
+pub struct Loaded {
+    pub grey: Array2<f64>,
+    /// "float" for a float TIFF (solid fraction), else the colour type read.
+    pub kind: String,
+    /// Full-scale value of the integer type (255, 65535), 1 for float.
+    pub full_scale: f64,
+}
+
+pub fn load(path: &Path, channel: Channel) -> Result<Loaded> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read image file {}", path.display()))?;
+    if bytes.is_empty() {
+        bail!("image file {} is empty (0 bytes): give a PNG, JPEG or TIFF image", path.display());
+    }
+    let is_tiff = bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*");
+    if is_tiff && let Some(l) = load_float_tiff(&bytes).with_context(|| format!("reading TIFF {}", path.display()))? {
+        return Ok(l);
+    }
+    let img = image::load_from_memory(&bytes).with_context(|| {
+        format!("cannot decode image file {}: give a PNG, JPEG or TIFF (8/16-bit, or 32-bit float grey)", path.display())
+    })?;
+    let kind = format!("{:?}", img.color());
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let is16 = matches!(
+        img.color(),
+        image::ColorType::L16 | image::ColorType::La16 | image::ColorType::Rgb16 | image::ColorType::Rgba16
+    );
+    let grey = if is16 {
+        let rgb = img.to_rgb16();
+        Array2::from_shape_fn((h, w), |(r, c)| pick(rgb.get_pixel(c as u32, r as u32).0.map(f64::from), channel))
+    } else {
+        let rgb = img.to_rgb8();
+        Array2::from_shape_fn((h, w), |(r, c)| pick(rgb.get_pixel(c as u32, r as u32).0.map(f64::from), channel))
+    };
+    Ok(Loaded { grey, kind, full_scale: if is16 { 65535.0 } else { 255.0 } })
+}
+
+fn pick(p: [f64; 3], channel: Channel) -> f64 {
+    match channel {
+        Channel::Luma => 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2],
+        Channel::Red => p[0],
+        Channel::Green => p[1],
+        Channel::Blue => p[2],
+    }
+}
+
+/// A one-sample float TIFF, or `None` for any other TIFF (left to `image`).
+fn load_float_tiff(bytes: &[u8]) -> Result<Option<Loaded>> {
+    use lbdem_grains::tiff::ColorType;
+    use lbdem_grains::tiff::decoder::{Decoder, DecodingResult};
+    let mut dec = Decoder::new(std::io::Cursor::new(bytes))?;
+    let (w, h) = dec.dimensions()?;
+    if !matches!(dec.colortype()?, ColorType::Gray(32) | ColorType::Gray(64)) {
+        return Ok(None);
+    }
+    let values: Vec<f64> = match dec.read_image()? {
+        DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
+        DecodingResult::F64(v) => v,
+        _ => return Ok(None),
+    };
+    let (w, h) = (w as usize, h as usize);
+    if values.len() != w * h {
+        bail!("float TIFF holds {} samples for {w} x {h} pixels", values.len());
+    }
+    Ok(Some(Loaded { grey: Array2::from_shape_vec((h, w), values)?, kind: "float".into(), full_scale: 1.0 }))
+}
