@@ -10,10 +10,12 @@
 pub mod collision;
 pub mod domain;
 pub mod kernel;
+pub mod kernel_aa;
 pub mod lattice;
 pub mod plan;
 pub mod real;
 pub mod stepper;
+pub mod stepper_aa;
 pub mod zouhe;
 
 pub use collision::Collision;
@@ -22,6 +24,7 @@ pub use kernel::Limits;
 pub use lattice::{D2Q9, D3Q19, Lattice};
 pub use real::Real;
 pub use stepper::{Fluid, ForceTorque, Macro, Settings, Stepper};
+pub use stepper_aa::StepperAa;
 
 /// Errors of the LBM engine; each names the parameter, its value, the limit and the fix.
 #[derive(Debug, thiserror::Error)]

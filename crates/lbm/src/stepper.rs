@@ -290,30 +290,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             if finite && rho > lim.rho_min && rho < lim.rho_max && speed < lim.u_max {
                 continue;
             }
-            let mach = speed / (1.0f64 / 3.0).sqrt();
-            let cause = if !finite && tau < 0.55 {
-                format!(
-                    "relaxation time tau = {tau:.4} is close to 0.5 (under-resolved viscosity); raise tau \
-                     (larger viscosity or time step relative to dx^2) or use TRT"
-                )
-            } else if speed >= lim.u_max || (!finite && mach > 0.3) {
-                format!(
-                    "local Mach number |u|/c_s = {mach:.3} beyond the limit {:.3}: lower the velocity in \
-                     lattice units (smaller time step or coarser dx)",
-                    lim.u_max / (1.0f64 / 3.0).sqrt()
-                )
-            } else if finite {
-                format!(
-                    "density {rho:.4} outside [{}, {}]: compressibility error from a too large pressure \
-                     drop or velocity; lower the driving (force, pressure, velocity) in lattice units",
-                    lim.rho_min, lim.rho_max
-                )
-            } else {
-                format!(
-                    "non-finite value with tau = {tau:.4}: the run went unstable (most often tau near 0.5 \
-                     or Mach too high); raise tau, refine the lattice or lower the velocity"
-                )
-            };
+            let cause = likely_cause(tau, rho, u, &lim);
             return LbmError::Unstable {
                 step: fluid.step,
                 node: [x, y, z],
@@ -329,6 +306,36 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             u: [f64::NAN; 3],
             cause: "row flagged but no bad node found (internal)".into(),
         }
+    }
+}
+
+/// The likely cause of a node leaving the limits, with the fix.
+pub(crate) fn likely_cause(tau: f64, rho: f64, u: [f64; 3], lim: &Limits) -> String {
+    let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    let finite = rho.is_finite() && speed.is_finite();
+    let mach = speed / (1.0f64 / 3.0).sqrt();
+    if !finite && tau < 0.55 {
+        format!(
+            "relaxation time tau = {tau:.4} is close to 0.5 (under-resolved viscosity); raise tau \
+             (larger viscosity or time step relative to dx^2) or use TRT"
+        )
+    } else if speed >= lim.u_max || (!finite && mach > 0.3) {
+        format!(
+            "local Mach number |u|/c_s = {mach:.3} beyond the limit {:.3}: lower the velocity in \
+             lattice units (smaller time step or coarser dx)",
+            lim.u_max / (1.0f64 / 3.0).sqrt()
+        )
+    } else if finite {
+        format!(
+            "density {rho:.4} outside [{}, {}]: compressibility error from a too large pressure \
+             drop or velocity; lower the driving (force, pressure, velocity) in lattice units",
+            lim.rho_min, lim.rho_max
+        )
+    } else {
+        format!(
+            "non-finite value with tau = {tau:.4}: the run went unstable (most often tau near 0.5 \
+             or Mach too high); raise tau, refine the lattice or lower the velocity"
+        )
     }
 }
 
