@@ -49,6 +49,9 @@ pub struct LatticeCfg {
     pub mach_warn: f64,
     #[serde(default = "mach_max")]
     pub mach_max: f64,
+    /// "aa" (in-place, default when no face is Zou-He) or "two-array" (needed for Zou-He faces).
+    #[serde(default = "auto")]
+    pub kernel: String,
     /// Rayon threads (0 = all cores).
     #[serde(default)]
     pub threads: usize,
@@ -167,6 +170,9 @@ fn d2q9() -> String {
 }
 fn f64s() -> String {
     "f64".into()
+}
+fn auto() -> String {
+    "auto".into()
 }
 fn trt() -> String {
     "trt".into()

@@ -14,7 +14,31 @@ use crate::stages::StageOutput;
 use anyhow::{Context, Result, bail};
 use config::{FaceCfg, FluidScene};
 use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
-use lbdem_lbm::{Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, Limits, Macro, Motion, Real, Settings, Stepper};
+use lbdem_lbm::{
+    Collision, D2Q9, D3Q19, Domain, Face, Fluid, ForceTorque, Lattice, LbmError, Limits, Macro, Motion, Real,
+    Settings, Stepper, StepperAa,
+};
+
+/// The kernel a scene runs on: in-place AA (half the memory traffic) unless a face is Zou-He.
+enum Engine<L: Lattice, T: Real> {
+    Aa(StepperAa<L, T>),
+    TwoArray(Stepper<L, T>),
+}
+
+impl<L: Lattice, T: Real> Engine<L, T> {
+    fn step(&mut self, fluid: &mut Fluid<L, T>, out: Option<&mut Macro>) -> Result<(), LbmError> {
+        match self {
+            Engine::Aa(s) => s.step(fluid, out),
+            Engine::TwoArray(s) => s.step(fluid, out),
+        }
+    }
+    fn forces(&self) -> &[ForceTorque] {
+        match self {
+            Engine::Aa(s) => &s.forces,
+            Engine::TwoArray(s) => &s.forces,
+        }
+    }
+}
 use output::{Sample, Writer};
 
 /// Everything derived from the scene file before the run.
@@ -32,6 +56,8 @@ struct Setup {
     sample_every: u64,
     snapshot_every: u64,
     threads: usize,
+    /// "aa" or "two-array".
+    kernel: &'static str,
 }
 
 enum ObstacleShape {
@@ -182,7 +208,17 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
     } else {
         (steps / s.output.snapshots).max(1)
     };
+    let any_zou_he = faces.iter().any(|f| f.is_zou_he());
+    let kernel = match (l.kernel.as_str(), any_zou_he) {
+        ("auto", false) | ("aa", false) => "aa",
+        ("auto", true) | ("two-array", _) => "two-array",
+        ("aa", true) => bail!(
+            "[lattice] kernel = \"aa\" with a Zou-He (velocity/pressure) face: use kernel = \"two-array\" or \"auto\""
+        ),
+        (other, _) => bail!("[lattice] kernel = \"{other}\" is not known; use \"auto\", \"aa\" or \"two-array\""),
+    };
     Ok(Setup {
+        kernel,
         units,
         dim,
         n,
@@ -247,7 +283,11 @@ fn run_typed<L: Lattice, T: Real>(su: &Setup, ctx: &SimContext) -> Result<StageO
         force: su.force,
         limits: Limits::default(),
     };
-    let mut stepper = Stepper::new(&fluid, settings).context("lattice set-up refused")?;
+    let mut stepper = if su.kernel == "aa" {
+        Engine::Aa(StepperAa::new(&mut fluid, settings).context("lattice set-up refused")?)
+    } else {
+        Engine::TwoArray(Stepper::new(&fluid, settings).context("lattice set-up refused")?)
+    };
     let mut writer = Writer::new(ctx, su, names)?;
     let mut m = Macro::default();
     let mut last_mean: Option<f64> = None;
@@ -265,7 +305,7 @@ fn run_typed<L: Lattice, T: Real>(su: &Setup, ctx: &SimContext) -> Result<StageO
             )));
         }
         if sample {
-            let smp = Sample::take(&fluid, &stepper, &m, &su.units, su.dim, su.n);
+            let smp = Sample::take(&fluid, stepper.forces(), &m, &su.units, su.dim, su.n);
             let mean = smp.mean_u[0].hypot(smp.mean_u[1]).hypot(smp.mean_u[2]);
             writer.push(smp);
             if let (Some(tol), Some(prev)) = (su.steady_tol, last_mean)

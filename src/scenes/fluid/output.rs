@@ -9,7 +9,7 @@ use lbdem_core::atomic::write_atomic;
 use lbdem_core::units::lattice::LatticeUnits;
 use lbdem_core::vtk::{Array, Values, write_pvd, write_vti};
 use lbdem_lbm::domain::FLUID;
-use lbdem_lbm::{Face, Fluid, Lattice, Macro, Real, Stepper};
+use lbdem_lbm::{Face, Fluid, ForceTorque, Lattice, Macro, Real};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -31,7 +31,7 @@ pub struct Sample {
 impl Sample {
     pub fn take<L: Lattice, T: Real>(
         fluid: &Fluid<L, T>,
-        st: &Stepper<L, T>,
+        forces: &[ForceTorque],
         m: &Macro,
         u: &LatticeUnits,
         dim: usize,
@@ -60,7 +60,7 @@ impl Sample {
             }
         }
         let n_obst = fluid.obstacles.len();
-        let fs = &st.forces[..n_obst];
+        let fs = &forces[..n_obst];
         let drop = if n_in > 0 && n_out > 0 {
             u.density_to_pressure(1.0 + p_in / n_in as f64 - p_out / n_out as f64)
         } else {
@@ -205,6 +205,7 @@ impl Writer {
             "fluid_nodes": fluid.domain.fluid_count(),
             "units": su.units,
             "collision": su.collision,
+            "kernel": su.kernel,
             "faces": faces,
             "steps": fluid.step,
             "time_s": fluid.step as f64 * su.units.dt,
