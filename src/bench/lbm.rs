@@ -48,7 +48,12 @@ fn steps_for(n: usize) -> usize {
 fn lbm_mlups<T: Real>(nx: usize, ny: usize, reps: usize, aa: bool) -> Result<f64> {
     let mut fluid = Fluid::<D2Q9, T>::new(Domain::periodic([nx, ny, 1]), Vec::new());
     // relaxation rate 1.8 as in lbmpy_bench.py; small perturbation so nothing is trivially constant
-    fluid.init_equilibrium(|p| (1.0 + 1e-4 * (((p[0] * 7 + p[1] * 13) % 17) as f64 / 17.0 - 0.5), [0.0; 3]));
+    fluid.init_equilibrium(|p| {
+        (
+            1.0 + 1e-4 * (((p[0] * 7 + p[1] * 13) % 17) as f64 / 17.0 - 0.5),
+            [0.0; 3],
+        )
+    });
     let settings = Settings {
         collision: Collision::Bgk { tau: 1.0 / 1.8 },
         force: [0.0; 3],
@@ -100,7 +105,8 @@ fn ceilings<T: Real>(n: usize, reps: usize) -> (f64, f64) {
         let t = Instant::now();
         for _ in 0..steps {
             for arr in c.iter_mut() {
-                arr.par_chunks_mut(CHUNK).for_each(|x| x.iter_mut().for_each(|v| *v = *v * s));
+                arr.par_chunks_mut(CHUNK)
+                    .for_each(|x| x.iter_mut().for_each(|v| *v = *v * s));
             }
         }
         let t_in = t.elapsed().as_secs_f64();
@@ -119,11 +125,19 @@ fn lbmpy(nx: usize, ny: usize, precision: &str, threads: usize) -> Option<f64> {
     let dtype = if precision == "f64" { "float64" } else { "float32" };
     let out = Command::new("bash")
         .arg(&script)
-        .args([format!("{nx}x{ny}"), dtype.into(), threads.to_string(), "aa".into()])
+        .args([
+            format!("{nx}x{ny}"),
+            dtype.into(),
+            threads.to_string(),
+            "aa".into(),
+        ])
         .output();
     let parse = |o: std::process::Output| -> Option<f64> {
         let line = String::from_utf8_lossy(&o.stdout).lines().last()?.to_string();
-        serde_json::from_str::<serde_json::Value>(&line).ok()?.get("median")?.as_f64()
+        serde_json::from_str::<serde_json::Value>(&line)
+            .ok()?
+            .get("median")?
+            .as_f64()
     };
     match out {
         Ok(o) if o.status.success() => parse(o),
@@ -164,7 +178,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                         )
                     })
                 })?;
-                let peer = if a.peer { lbmpy(nx, ny, precision, threads) } else { None };
+                let peer = if a.peer {
+                    lbmpy(nx, ny, precision, threads)
+                } else {
+                    None
+                };
                 let row = Row {
                     nx,
                     ny,

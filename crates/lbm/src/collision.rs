@@ -31,13 +31,13 @@ impl Collision {
     /// (ω⁺, ω⁻), refusing τ ≤ ½ or Λ ≤ 0.
     pub fn rates(&self) -> Result<(f64, f64), LbmError> {
         let tau = self.tau();
-        if !(tau > 0.5) || !tau.is_finite() {
+        if tau.is_nan() || tau <= 0.5 || !tau.is_finite() {
             return Err(LbmError::Tau { tau });
         }
         match *self {
             Collision::Bgk { .. } => Ok((1.0 / tau, 1.0 / tau)),
             Collision::Trt { magic, .. } => {
-                if !(magic > 0.0) || !magic.is_finite() {
+                if magic.is_nan() || magic <= 0.0 || !magic.is_finite() {
                     return Err(LbmError::Magic { magic });
                 }
                 let tau_m = 0.5 + magic / (tau - 0.5);
@@ -149,13 +149,13 @@ pub fn collide_block<L: Lattice, T: Real, const W: usize>(
         let wi = T::from_f64(L::W[i]);
         let mut cf = zero;
         for a in 0..L::D {
-            cf = cf + T::from_f64(c[a] as f64) * p.force[a];
+            cf += T::from_f64(c[a] as f64) * p.force[a];
         }
         for w in 0..W {
             let mut cu = zero;
             for a in 0..L::D {
                 if c[a] != 0 {
-                    cu = cu + T::from_f64(c[a] as f64) * u[a][w];
+                    cu += T::from_f64(c[a] as f64) * u[a][w];
                 }
             }
             let wr = wi * rho[w];

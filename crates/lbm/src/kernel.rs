@@ -189,9 +189,13 @@ unsafe fn general_node<L: Lattice, T: Real>(ctx: &Ctx<T>, p: [usize; 3]) -> bool
         }
     }
     if missing != 0 {
-        let face = (0..4).find(|&fc| {
+        let face = (0..4usize).find(|&fc| {
             let a = fc / 2;
-            let on = if fc % 2 == 0 { p[a] == 0 } else { p[a] + 1 == dom.n[a] };
+            let on = if fc.is_multiple_of(2) {
+                p[a] == 0
+            } else {
+                p[a] + 1 == dom.n[a]
+            };
             on && dom.faces[fc].is_zou_he()
         });
         match face {

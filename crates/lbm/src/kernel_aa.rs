@@ -34,7 +34,13 @@ pub struct CtxAa<'a, T> {
 }
 
 #[inline(always)]
-fn check<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize, count: usize, bad: &mut Bad) {
+fn check<T: Real, const B: usize>(
+    ctx: &CtxAa<T>,
+    m: &Moments<T, B>,
+    idx0: usize,
+    count: usize,
+    bad: &mut Bad,
+) {
     let l = &ctx.limits;
     let mut any = false;
     for w in 0..count {
@@ -93,7 +99,9 @@ pub unsafe fn even_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
             let mut f = [[T::default(); W]; QMAX];
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
                 // SAFETY: in bounds, own nodes.
-                unsafe { std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + row_off + xb), fi.as_mut_ptr(), W) };
+                unsafe {
+                    std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + row_off + xb), fi.as_mut_ptr(), W)
+                };
             }
             let m = collide_block::<L, T, W>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
@@ -151,11 +159,15 @@ pub unsafe fn odd_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
         while xb + W <= x1 {
             let mut f = [[T::default(); W]; QMAX];
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                unsafe { std::ptr::copy_nonoverlapping(ctx.f.0.add(up[i].wrapping_add(xb)), fi.as_mut_ptr(), W) };
+                unsafe {
+                    std::ptr::copy_nonoverlapping(ctx.f.0.add(up[i].wrapping_add(xb)), fi.as_mut_ptr(), W)
+                };
             }
             let m = collide_block::<L, T, W>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(down[i].wrapping_add(xb)), W) };
+                unsafe {
+                    std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(down[i].wrapping_add(xb)), W)
+                };
             }
             check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
             xb += W;
@@ -212,7 +224,9 @@ unsafe fn odd_general<L: Lattice, T: Real>(ctx: &CtxAa<T>, p: [usize; 3], bad: &
                 let uw = wall_velocity(ctx, p, c, -1.0, s);
                 unsafe { *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, uw)) }
             }
-            Upstream::Face(fc) => unsafe { *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, face_velocity(fc))) },
+            Upstream::Face(fc) => unsafe {
+                *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, face_velocity(fc)))
+            },
         };
     }
     let m = collide_block::<L, T, 1>(&mut f, &ctx.params);
@@ -225,7 +239,9 @@ unsafe fn odd_general<L: Lattice, T: Real>(ctx: &CtxAa<T>, p: [usize; 3], bad: &
                 let uw = wall_velocity(ctx, p, c, 1.0, s);
                 unsafe { *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, uw)) }
             }
-            Upstream::Face(fc) => unsafe { *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, face_velocity(fc))) },
+            Upstream::Face(fc) => unsafe {
+                *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, face_velocity(fc)))
+            },
         }
     }
     check::<T, 1>(ctx, &m, idx, 1, bad);

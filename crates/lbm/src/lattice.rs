@@ -134,7 +134,9 @@ mod tests {
         // isotropy: sum w c_a c_b = cs2 delta_ab
         for a in 0..3 {
             for b in 0..3 {
-                let s: f64 = (0..L::Q).map(|i| L::W[i] * (L::C[i][a] * L::C[i][b]) as f64).sum();
+                let s: f64 = (0..L::Q)
+                    .map(|i| L::W[i] * (L::C[i][a] * L::C[i][b]) as f64)
+                    .sum();
                 let want = if a == b && a < L::D { CS2 } else { 0.0 };
                 assert!((s - want).abs() < 1e-15, "{} {a}{b}", L::NAME);
             }

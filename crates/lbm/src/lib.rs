@@ -7,6 +7,10 @@
 //! stepper that stops at the first node leaving the accepted range with a diagnosis ([`stepper`]).
 //! Pure computation: no file I/O; units are converted in `lbdem_core::units::lattice`.
 
+// Kernels index several parallel arrays (velocities, weights, populations) by direction: an index
+// loop says that more plainly than zipped iterators.
+#![allow(clippy::needless_range_loop)]
+
 pub mod collision;
 pub mod domain;
 pub mod kernel;

@@ -143,7 +143,11 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
                 )));
             }
         }
-        if dom.obstacle.iter().any(|&o| o != u16::MAX && o as usize >= fluid.obstacles.len()) {
+        if dom
+            .obstacle
+            .iter()
+            .any(|&o| o != u16::MAX && o as usize >= fluid.obstacles.len())
+        {
             return Err(LbmError::Unsupported(
                 "a node is marked with an obstacle id that has no motion entry; push a Motion per obstacle"
                     .into(),

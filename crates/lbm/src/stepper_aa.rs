@@ -116,19 +116,22 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             out,
         };
         let odd = self.reversed;
-        self.bad.par_chunks_mut(ROWS_PER_TASK).enumerate().for_each(|(c, flags)| {
-            for (k, b) in flags.iter_mut().enumerate() {
-                let r = c * ROWS_PER_TASK + k;
-                // SAFETY: every node touches only its own slots (kernel_aa module doc).
-                *b = unsafe {
-                    if odd {
-                        kernel_aa::odd_row::<L, T>(&ctx, r)
-                    } else {
-                        kernel_aa::even_row::<L, T>(&ctx, r)
-                    }
-                };
-            }
-        });
+        self.bad
+            .par_chunks_mut(ROWS_PER_TASK)
+            .enumerate()
+            .for_each(|(c, flags)| {
+                for (k, b) in flags.iter_mut().enumerate() {
+                    let r = c * ROWS_PER_TASK + k;
+                    // SAFETY: every node touches only its own slots (kernel_aa module doc).
+                    *b = unsafe {
+                        if odd {
+                            kernel_aa::odd_row::<L, T>(&ctx, r)
+                        } else {
+                            kernel_aa::even_row::<L, T>(&ctx, r)
+                        }
+                    };
+                }
+            });
         self.reversed = !self.reversed;
         fluid.step += 1;
         if let Some((r, Some((x, rho, u)))) = self.bad.iter().enumerate().find(|(_, b)| b.is_some()) {
@@ -171,7 +174,11 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             };
             let cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1] + c[2] as f64 * uw[2];
             let stored = fluid.f[o * n + l.node as usize].to_f64();
-            let post = if self.reversed { stored } else { stored + 6.0 * L::W[i] * cu };
+            let post = if self.reversed {
+                stored
+            } else {
+                stored + 6.0 * L::W[i] * cu
+            };
             let mag = 2.0 * post - 6.0 * L::W[i] * cu;
             let fl = c.map(|ca| mag * ca as f64);
             let ft = &mut self.forces[t];

@@ -14,7 +14,7 @@ use crate::real::Real;
 pub fn apply<L: Lattice, T: Real>(f: &mut [[T; 1]; QMAX], face_id: usize, face: &Face, missing: u32) {
     let a = face_id / 2;
     let t = 1 - a; // tangential axis (2D)
-    let n: i32 = if face_id % 2 == 0 { 1 } else { -1 };
+    let n: i32 = if face_id.is_multiple_of(2) { 1 } else { -1 };
     let (mut sum_t, mut sum_o, mut mom_t) = (0.0, 0.0, 0.0);
     for i in 0..L::Q {
         let c = L::C[i];

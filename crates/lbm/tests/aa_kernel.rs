@@ -2,6 +2,7 @@
 //! even number of steps (periodic faces, moving walls, a rotating obstacle, body force, D2Q9 and
 //! D3Q19, f64 and f32), the same forces, and identical results for 1 and 2 threads.
 
+#![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, Motion, Real, Stepper, StepperAa};
@@ -11,8 +12,22 @@ fn setup<L: Lattice, T: Real>(n: [usize; 3]) -> Fluid<L, T> {
         velocity: [0.02, 0.0, 0.0],
     };
     let wall = Face::Wall { velocity: [0.0; 3] };
-    let mut dom = Domain::new(n, [Face::Periodic, Face::Periodic, wall, lid, Face::Periodic, Face::Periodic]);
-    let c = [n[0] as f64 / 3.0, n[1] as f64 / 2.0, if n[2] > 1 { n[2] as f64 / 2.0 } else { 0.0 }];
+    let mut dom = Domain::new(
+        n,
+        [
+            Face::Periodic,
+            Face::Periodic,
+            wall,
+            lid,
+            Face::Periodic,
+            Face::Periodic,
+        ],
+    );
+    let c = [
+        n[0] as f64 / 3.0,
+        n[1] as f64 / 2.0,
+        if n[2] > 1 { n[2] as f64 / 2.0 } else { 0.0 },
+    ];
     dom.fill_sphere(0, c, n[1] as f64 / 5.0);
     let mut fl = Fluid::<L, T>::new(
         dom,
@@ -27,7 +42,13 @@ fn setup<L: Lattice, T: Real>(n: [usize; 3]) -> Fluid<L, T> {
 }
 
 fn compare<L: Lattice, T: Real>(n: [usize; 3], steps: usize) {
-    let s = settings(Collision::Trt { tau: 0.7, magic: 0.25 }, [1e-5, 0.0, 0.0]);
+    let s = settings(
+        Collision::Trt {
+            tau: 0.7,
+            magic: 0.25,
+        },
+        [1e-5, 0.0, 0.0],
+    );
     let mut a = setup::<L, T>(n);
     let mut b = a.clone();
     let mut two = Stepper::new(&a, s).unwrap();
@@ -40,13 +61,29 @@ fn compare<L: Lattice, T: Real>(n: [usize; 3], steps: usize) {
                 // forces after odd steps come from a bounced value minus the wall term: round-off of T
                 let tol = if T::NAME == "f64" { 1e-10 } else { 1e-4 };
                 let scale = x.force[d].abs().max(1e-6);
-                assert!((x.force[d] - y.force[d]).abs() < tol * scale, "{} step {k}: {x:?} {y:?}", T::NAME);
+                assert!(
+                    (x.force[d] - y.force[d]).abs() < tol * scale,
+                    "{} step {k}: {x:?} {y:?}",
+                    T::NAME
+                );
             }
         }
     }
     aa.finish(&mut b).unwrap();
-    let same = a.f.iter().zip(&b.f).filter(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits()).count();
-    assert_eq!(same, a.f.len(), "{} {}: {} of {} populations differ", L::NAME, T::NAME, a.f.len() - same, a.f.len());
+    let same =
+        a.f.iter()
+            .zip(&b.f)
+            .filter(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits())
+            .count();
+    assert_eq!(
+        same,
+        a.f.len(),
+        "{} {}: {} of {} populations differ",
+        L::NAME,
+        T::NAME,
+        a.f.len() - same,
+        a.f.len()
+    );
 }
 
 #[test]
@@ -63,7 +100,10 @@ fn aa_equals_two_array_d3q19() {
 #[test]
 fn aa_identical_for_one_and_two_threads() {
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let mut fl = setup::<D2Q9, f64>([64, 48, 1]);
             let s = settings(Collision::Bgk { tau: 0.6 }, [1e-5, 0.0, 0.0]);

@@ -2,6 +2,7 @@
 //! u along the vertical centre line x = 0.5 (129 x 129 grid for Re = 100 and 1000).
 //! Lid = halfway bounce-back wall moving at U (Leonardi Eq. 19); the other walls at rest.
 
+#![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, Domain, Face, Fluid, Stepper};
@@ -56,6 +57,12 @@ fn re100_matches_ghia() {
 #[test]
 #[ignore]
 fn re1000_matches_ghia() {
-    let err = cavity(256, 1000.0, 0.1, |tau| Collision::Trt { tau, magic: 0.25 }, &GHIA_U_RE1000);
+    let err = cavity(
+        256,
+        1000.0,
+        0.1,
+        |tau| Collision::Trt { tau, magic: 0.25 },
+        &GHIA_U_RE1000,
+    );
     assert!(err < 0.02, "{err}");
 }

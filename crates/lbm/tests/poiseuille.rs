@@ -5,6 +5,7 @@
 //! and Λ = the magic parameter for TRT (Ginzburg & Adler, J. Phys. II France 4 (1994) 191;
 //! Pan, Luo & Miller, Comput. Fluids 35 (2006) 898). A correct code matches it to round-off.
 
+#![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, Stepper};
@@ -68,7 +69,17 @@ fn bgk_slip_grows_with_tau_as_published_and_trt_stays_flat() {
 fn trt_magic_3_16_is_exact_in_d3q19() {
     let wall = Face::Wall { velocity: [0.0; 3] };
     let h = 10;
-    let dom = Domain::new([3, h, 3], [Face::Periodic, Face::Periodic, wall, wall, Face::Periodic, Face::Periodic]);
+    let dom = Domain::new(
+        [3, h, 3],
+        [
+            Face::Periodic,
+            Face::Periodic,
+            wall,
+            wall,
+            Face::Periodic,
+            Face::Periodic,
+        ],
+    );
     let c = Collision::Trt {
         tau: 0.7,
         magic: 3.0 / 16.0,
@@ -89,10 +100,17 @@ fn trt_with_halfway_bounce_back_converges_at_second_order() {
     let mut errs = Vec::new();
     let hs = [8, 16, 32];
     for &h in &hs {
-        let c = Collision::Trt { tau: 0.8, magic: 0.25 };
+        let c = Collision::Trt {
+            tau: 0.8,
+            magic: 0.25,
+        };
         let g = g_of(h);
         let (u, nu) = profile::<D2Q9>(channel(4, h), c, g);
-        let num: f64 = u.iter().enumerate().map(|(y, v)| (v - analytic(y, h, g, nu)).powi(2)).sum();
+        let num: f64 = u
+            .iter()
+            .enumerate()
+            .map(|(y, v)| (v - analytic(y, h, g, nu)).powi(2))
+            .sum();
         let den: f64 = (0..h).map(|y| analytic(y, h, g, nu).powi(2)).sum();
         errs.push((num / den).sqrt());
     }
@@ -106,7 +124,10 @@ fn trt_with_halfway_bounce_back_converges_at_second_order() {
 fn results_identical_for_one_and_two_threads() {
     // A channel with a cylinder: boundary links, general and fast paths, forces.
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let mut dom = channel(64, 33);
             dom.fill_sphere(0, [20.0, 16.0, 0.0], 5.0);
@@ -118,8 +139,17 @@ fn results_identical_for_one_and_two_threads() {
                     ..Default::default()
                 }],
             );
-            let mut st = Stepper::new(&fluid, settings(Collision::Trt { tau: 0.7, magic: 0.25 }, [1e-5, 0.0, 0.0]))
-                .unwrap();
+            let mut st = Stepper::new(
+                &fluid,
+                settings(
+                    Collision::Trt {
+                        tau: 0.7,
+                        magic: 0.25,
+                    },
+                    [1e-5, 0.0, 0.0],
+                ),
+            )
+            .unwrap();
             let mut forces = Vec::new();
             for _ in 0..300 {
                 st.step(&mut fluid, None).unwrap();

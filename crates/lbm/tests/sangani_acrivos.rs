@@ -4,6 +4,7 @@
 //! with F the drag per unit length and U the mean superficial velocity; F = L² G for a mean
 //! pressure gradient G, which a uniform body force g on the fluid reproduces (G = g).
 
+#![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Motion, Stepper};
@@ -31,12 +32,18 @@ fn drag(l: usize, phi: f64) -> (f64, f64) {
             ..Default::default()
         }],
     );
-    let coll = Collision::Trt { tau: 1.0, magic: 3.0 / 16.0 };
+    let coll = Collision::Trt {
+        tau: 1.0,
+        magic: 3.0 / 16.0,
+    };
     let g = 1e-6;
     let mut st = Stepper::new(&fluid, settings(coll, [g, 0.0, 0.0])).unwrap();
     let (m, _) = run_steady(&mut fluid, &mut st, 200, 1e-13, 200_000);
     let n = fluid.nodes();
-    let u_sum: f64 = (0..n).filter(|&i| fluid.domain.kind[i] == 0).map(|i| m.u[3 * i]).sum();
+    let u_sum: f64 = (0..n)
+        .filter(|&i| fluid.domain.kind[i] == 0)
+        .map(|i| m.u[3 * i])
+        .sum();
     let u_sup = u_sum / (l * l) as f64;
     let k = g * (l * l) as f64 / (coll.nu() * u_sup);
     (k, st.forces[0].force[0] / (g * fluid_nodes))
@@ -47,7 +54,10 @@ fn check(l: usize, phis: &[usize], tol: f64) {
         let (phi, want) = TABLE[k];
         let (got, balance) = drag(l, phi);
         let err = (got - want).abs() / want;
-        eprintln!("L={l} phi={phi}: F/(mu U) = {got:.3}, Sangani-Acrivos {want}, error {:.2}%", 100.0 * err);
+        eprintln!(
+            "L={l} phi={phi}: F/(mu U) = {got:.3}, Sangani-Acrivos {want}, error {:.2}%",
+            100.0 * err
+        );
         // steady state: the drag from momentum exchange balances the body force on the fluid
         assert!((balance - 1.0).abs() < 1e-4, "force balance {balance}");
         assert!(err < tol, "phi {phi}: {got} vs {want}");

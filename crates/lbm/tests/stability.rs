@@ -7,6 +7,7 @@
 //! compressibility error of order Ma^2, or cell Reynolds number above 10, under-resolved) must end
 //! finite or be stopped with the diagnosis.
 
+#![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, LbmError, Macro, Stepper};
@@ -28,8 +29,15 @@ fn tg(collision: Collision, u0: f64) -> Outcome {
     let mut fl = Fluid::<D2Q9, f64>::new(Domain::periodic([l, l, 1]), no_obstacles());
     fl.init_equilibrium(|p| {
         let (x, y) = (p[0] as f64, p[1] as f64);
-        let u = [-u0 * (k * x).cos() * (k * y).sin(), u0 * (k * x).sin() * (k * y).cos(), 0.0];
-        (1.0 - 0.75 * u0 * u0 * ((2.0 * k * x).cos() + (2.0 * k * y).cos()), u)
+        let u = [
+            -u0 * (k * x).cos() * (k * y).sin(),
+            u0 * (k * x).sin() * (k * y).cos(),
+            0.0,
+        ];
+        (
+            1.0 - 0.75 * u0 * u0 * ((2.0 * k * x).cos() + (2.0 * k * y).cos()),
+            u,
+        )
     });
     // lattice units: dx = dt = 1, viscosity from tau, rho = 1
     let inp = LatticeInput::new(1.0, collision.nu(), 1.0, u0, TimeSpec::Tau(collision.tau()));
@@ -61,7 +69,11 @@ fn tg(collision: Collision, u0: f64) -> Outcome {
     }
     let nu_meas = (e[0] / e[1]).ln() / (4.0 * k * k * (t2 - t1) as f64);
     let err = (nu_meas - nu).abs() / nu;
-    if warned { Outcome::Warned(err) } else { Outcome::Accurate(err) }
+    if warned {
+        Outcome::Warned(err)
+    } else {
+        Outcome::Accurate(err)
+    }
 }
 
 fn assert_ok_or_diagnosed(o: &Outcome, what: &str) {
@@ -72,15 +84,24 @@ fn assert_ok_or_diagnosed(o: &Outcome, what: &str) {
             assert!(err.is_finite())
         }
         Outcome::Stopped(e) => {
-            let LbmError::Unstable { step, node, cause, .. } = e else {
+            let LbmError::Unstable {
+                step, node, cause, ..
+            } = e
+            else {
                 panic!("{what}: unexpected error {e}")
             };
             assert!(*step > 0 && node[0] < 32 && node[1] < 32, "{what}: {e}");
             assert!(!cause.is_empty());
             let msg = e.to_string();
-            assert!(msg.contains("step") && msg.contains("node") && msg.contains("likely cause"), "{msg}");
+            assert!(
+                msg.contains("step") && msg.contains("node") && msg.contains("likely cause"),
+                "{msg}"
+            );
         }
-        Outcome::Refused(e) => assert!(e.contains("tau") || e.contains("Mach") || e.contains("viscosity"), "{what}: {e}"),
+        Outcome::Refused(e) => assert!(
+            e.contains("tau") || e.contains("Mach") || e.contains("viscosity"),
+            "{what}: {e}"
+        ),
     }
 }
 
@@ -151,7 +172,14 @@ fn blow_up_is_stopped_at_first_bad_step_with_node() {
 #[ignore]
 fn explore_tau() {
     for tau in [0.52, 0.515, 0.51, 0.507, 0.505, 0.502, 0.5005] {
-        for c in [Collision::Bgk { tau }, Collision::Trt { tau, magic: 0.25 }, Collision::Trt { tau, magic: 3.0/16.0 }] {
+        for c in [
+            Collision::Bgk { tau },
+            Collision::Trt { tau, magic: 0.25 },
+            Collision::Trt {
+                tau,
+                magic: 3.0 / 16.0,
+            },
+        ] {
             match tg(c, 0.05) {
                 Outcome::Accurate(e) | Outcome::Warned(e) => eprintln!("{c:?} err {e:.4}"),
                 Outcome::Stopped(e) => eprintln!("{c:?} stopped {e}"),

@@ -2,6 +2,7 @@
 //! velocity amplitude decays as exp(−2νk²t), the kinetic energy as exp(−4νk²t) (Taylor & Green,
 //! Proc. R. Soc. A 158 (1937) 499).
 
+#![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Macro, Stepper};
@@ -15,7 +16,11 @@ fn nu_error(l: usize, collision: Collision, u0: f64, f32_storage: bool) -> f64 {
     let t2 = (0.6 / (nu * k * k)) as usize;
     let init = |p: [usize; 3]| {
         let (x, y) = (p[0] as f64, p[1] as f64);
-        let u = [-u0 * (k * x).cos() * (k * y).sin(), u0 * (k * x).sin() * (k * y).cos(), 0.0];
+        let u = [
+            -u0 * (k * x).cos() * (k * y).sin(),
+            u0 * (k * x).sin() * (k * y).cos(),
+            0.0,
+        ];
         let rho = 1.0 - 3.0 * u0 * u0 / 4.0 * ((2.0 * k * x).cos() + (2.0 * k * y).cos());
         (rho, u)
     };
@@ -61,7 +66,15 @@ fn decay_rate_matches_viscosity_and_converges() {
 
 #[test]
 fn trt_and_f32_storage_decay_alike() {
-    let e_trt = nu_error(32, Collision::Trt { tau: 0.8, magic: 0.25 }, 0.01, false);
+    let e_trt = nu_error(
+        32,
+        Collision::Trt {
+            tau: 0.8,
+            magic: 0.25,
+        },
+        0.01,
+        false,
+    );
     let e_f32 = nu_error(32, Collision::Bgk { tau: 0.8 }, 0.01, true);
     eprintln!("TG nu error: TRT {e_trt:e}, f32 {e_f32:e}");
     assert!(e_trt < 1e-2 && e_f32 < 1e-2);

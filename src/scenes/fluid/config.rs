@@ -97,9 +97,13 @@ pub enum FaceCfg {
         velocity: Vec<f64>,
     },
     /// Zou-He velocity inlet/outlet (m/s).
-    Velocity { velocity: Vec<f64> },
+    Velocity {
+        velocity: Vec<f64>,
+    },
     /// Zou-He pressure (gauge Pa).
-    Pressure { pressure: f64 },
+    Pressure {
+        pressure: f64,
+    },
 }
 
 #[derive(Debug, Default, Deserialize)]

@@ -66,7 +66,10 @@ enum ObstacleShape {
 
 fn vec3(v: &[f64], dim: usize, what: &str) -> Result<[f64; 3]> {
     if !v.is_empty() && v.len() != dim {
-        bail!("{what} has {} components but the scene is {dim}D; give {dim} numbers", v.len());
+        bail!(
+            "{what} has {} components but the scene is {dim}D; give {dim} numbers",
+            v.len()
+        );
     }
     let mut out = [0.0; 3];
     for (o, x) in out.iter_mut().zip(v) {
@@ -99,12 +102,16 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
     inp.mach_max = l.mach_max;
     let units = LatticeUnits::derive(&inp).context("[lattice]/[fluid] parameters refused")?;
     let mut n = [1usize; 3];
-    for a in 0..dim {
+    for (a, na) in n.iter_mut().enumerate().take(dim) {
         let cells = s.domain.size[a] / l.dx;
-        if !(cells >= 2.0) || !cells.is_finite() {
-            bail!("[domain] size[{a}] = {} m gives {cells} nodes at dx = {} m; need at least 2", s.domain.size[a], l.dx);
+        if cells.is_nan() || cells < 2.0 || !cells.is_finite() {
+            bail!(
+                "[domain] size[{a}] = {} m gives {cells} nodes at dx = {} m; need at least 2",
+                s.domain.size[a],
+                l.dx
+            );
         }
-        n[a] = cells.round() as usize;
+        *na = cells.round() as usize;
     }
     let b = &s.boundaries;
     let face_cfgs = [&b.x_min, &b.x_max, &b.y_min, &b.y_max, &b.z_min, &b.z_max];
@@ -119,10 +126,18 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
         faces[k] = match fc {
             FaceCfg::Periodic => Face::Periodic,
             FaceCfg::Wall { velocity } => Face::Wall {
-                velocity: to_lu(vec3(velocity, dim, &format!("[boundaries] {} velocity", names[k]))?),
+                velocity: to_lu(vec3(
+                    velocity,
+                    dim,
+                    &format!("[boundaries] {} velocity", names[k]),
+                )?),
             },
             FaceCfg::Velocity { velocity } => Face::Velocity {
-                velocity: to_lu(vec3(velocity, dim, &format!("[boundaries] {} velocity", names[k]))?),
+                velocity: to_lu(vec3(
+                    velocity,
+                    dim,
+                    &format!("[boundaries] {} velocity", names[k]),
+                )?),
             },
             FaceCfg::Pressure { pressure } => Face::Pressure {
                 rho: 1.0 + units.pressure_to_density(*pressure),
@@ -143,7 +158,10 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
     for (k, o) in s.obstacles.iter().enumerate() {
         let want = if dim == 2 { "circle" } else { "sphere" };
         if o.shape != want {
-            bail!("[[obstacles]] #{k}: shape = \"{}\" in a {dim}D scene; use \"{want}\"", o.shape);
+            bail!(
+                "[[obstacles]] #{k}: shape = \"{}\" in a {dim}D scene; use \"{want}\"",
+                o.shape
+            );
         }
         if o.centre.len() != dim {
             bail!("[[obstacles]] #{k}: centre needs {dim} coordinates (m)");
@@ -156,7 +174,10 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
             Some(toml::Value::Float(w)) if dim == 2 => [0.0, 0.0, *w],
             Some(toml::Value::Integer(w)) if dim == 2 => [0.0, 0.0, *w as f64],
             Some(v) => {
-                let w: Vec<f64> = v.clone().try_into().context("[[obstacles]] omega: a number (2D) or 3 numbers")?;
+                let w: Vec<f64> = v
+                    .clone()
+                    .try_into()
+                    .context("[[obstacles]] omega: a number (2D) or 3 numbers")?;
                 vec3(&w, 3, "[[obstacles]] omega")?
             }
         };
@@ -166,7 +187,14 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
             omega: omega.map(|w| w * units.dt),
         };
         let name = o.name.clone().unwrap_or_else(|| format!("obstacle{k}"));
-        obstacles.push((name, motion, ObstacleShape::Sphere { centre, radius: o.radius / l.dx }));
+        obstacles.push((
+            name,
+            motion,
+            ObstacleShape::Sphere {
+                centre,
+                radius: o.radius / l.dx,
+            },
+        ));
     }
     let mask = match &s.mask {
         None => None,
@@ -203,11 +231,9 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
         _ => bail!("[stop] give exactly one of time (s) or steps"),
     };
     let sample_every = (steps / s.output.samples.max(1)).max(1);
-    let snapshot_every = if s.output.snapshots == 0 {
-        u64::MAX
-    } else {
-        (steps / s.output.snapshots).max(1)
-    };
+    let snapshot_every = steps
+        .checked_div(s.output.snapshots)
+        .map_or(u64::MAX, |k| k.max(1));
     let any_zou_he = faces.iter().any(|f| f.is_zou_he());
     let kernel = match (l.kernel.as_str(), any_zou_he) {
         ("auto", false) | ("aa", false) => "aa",
@@ -215,7 +241,9 @@ fn setup(s: &FluidScene, ctx: &SimContext) -> Result<Setup> {
         ("aa", true) => bail!(
             "[lattice] kernel = \"aa\" with a Zou-He (velocity/pressure) face: use kernel = \"two-array\" or \"auto\""
         ),
-        (other, _) => bail!("[lattice] kernel = \"{other}\" is not known; use \"auto\", \"aa\" or \"two-array\""),
+        (other, _) => {
+            bail!("[lattice] kernel = \"{other}\" is not known; use \"auto\", \"aa\" or \"two-array\"")
+        }
     };
     Ok(Setup {
         kernel,
@@ -244,7 +272,9 @@ pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
     for w in &setup.units.warnings {
         eprintln!("warning: {w}");
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(setup.threads).build()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(setup.threads)
+        .build()?;
     pool.install(|| match (setup.dim, s.lattice.precision.as_str()) {
         (2, "f64") => run_typed::<D2Q9, f64>(&setup, ctx),
         (2, "f32") => run_typed::<D2Q9, f32>(&setup, ctx),

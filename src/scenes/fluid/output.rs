@@ -71,8 +71,14 @@ impl Sample {
             time: fluid.step as f64 * u.dt,
             mean_u: sum.map(|s| u.velocity_to_si(s / cnt.max(1) as f64)),
             pressure_drop: drop,
-            force: fs.iter().map(|f| f.force.map(|x| u.force_to_si(x, dim))).collect(),
-            torque: fs.iter().map(|f| f.torque.map(|x| u.torque_to_si(x, dim))).collect(),
+            force: fs
+                .iter()
+                .map(|f| f.force.map(|x| u.force_to_si(x, dim)))
+                .collect(),
+            torque: fs
+                .iter()
+                .map(|f| f.torque.map(|x| u.torque_to_si(x, dim)))
+                .collect(),
             max_mach: umax2.sqrt() / (1.0f64 / 3.0).sqrt(),
         }
     }
@@ -114,10 +120,22 @@ impl Writer {
         let dom = &fluid.domain;
         let fluid_node = |i: usize| dom.kind[i] == FLUID;
         let vel: Vec<f64> = (0..3 * dom.len())
-            .map(|k| if fluid_node(k / 3) { u.velocity_to_si(m.u[k]) } else { 0.0 })
+            .map(|k| {
+                if fluid_node(k / 3) {
+                    u.velocity_to_si(m.u[k])
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let p: Vec<f64> = (0..dom.len())
-            .map(|i| if fluid_node(i) { u.density_to_pressure(m.rho[i]) } else { 0.0 })
+            .map(|i| {
+                if fluid_node(i) {
+                    u.density_to_pressure(m.rho[i])
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let kind: Vec<i32> = dom.kind.iter().map(|&k| k as i32).collect();
         let rel = format!("fields/fluid_{step:08}.vti");
@@ -125,7 +143,11 @@ impl Writer {
         write_vti(
             &path,
             dom.n,
-            [0.5 * u.dx, 0.5 * u.dx, if dom.n[2] > 1 { 0.5 * u.dx } else { 0.0 }],
+            [
+                0.5 * u.dx,
+                0.5 * u.dx,
+                if dom.n[2] > 1 { 0.5 * u.dx } else { 0.0 },
+            ],
             [u.dx; 3],
             &[
                 Array::vector("velocity", Values::F64(&vel)),
@@ -221,8 +243,9 @@ impl Writer {
             figures: Vec::new(),
             tables: vec![Table {
                 path: "series.csv".into(),
-                caption: "fluid time series: mean velocity, pressure drop, force and torque per obstacle (SI)"
-                    .into(),
+                caption:
+                    "fluid time series: mean velocity, pressure drop, force and torque per obstacle (SI)"
+                        .into(),
             }],
             files: self.files,
         })

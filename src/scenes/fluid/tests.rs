@@ -53,7 +53,11 @@ fn poiseuille_scene_in_si() {
     for f in ["series.csv", "series.json", "summary.json", "fluid.pvd"] {
         assert!(dir.path().join(f).exists(), "{f}");
     }
-    let vti = out.files.iter().find(|f| f.extension().is_some_and(|e| e == "vti")).unwrap();
+    let vti = out
+        .files
+        .iter()
+        .find(|f| f.extension().is_some_and(|e| e == "vti"))
+        .unwrap();
     let text = std::fs::read(dir.path().join(vti)).unwrap();
     assert!(text.starts_with(b"<?xml") && text.windows(9).any(|w| w == b"ImageData"));
 }
@@ -81,7 +85,10 @@ fn unstable_run_stops_and_writes_no_report() {
         .replace("time = 3.0", "time = 100000.0");
     let v: toml::Value = toml::from_str(&s).unwrap();
     let e = format!("{:#}", run(&v, &ctx(dir.path())).unwrap_err());
-    assert!(e.contains("unstable at step") && e.contains("likely cause"), "{e}");
+    assert!(
+        e.contains("unstable at step") && e.contains("likely cause"),
+        "{e}"
+    );
     for f in ["series.csv", "series.json", "summary.json", "fluid.pvd"] {
         assert!(!dir.path().join(f).exists(), "{f} written after a failed run");
     }

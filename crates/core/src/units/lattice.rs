@@ -130,13 +130,13 @@ impl LatticeUnits {
                 (dt, 0.5 + inp.nu * dt / (CS2 * inp.dx * inp.dx))
             }
             TimeSpec::Tau(tau) => {
-                if !(tau > 0.5) || !tau.is_finite() {
+                if tau.is_nan() || tau <= 0.5 || !tau.is_finite() {
                     return Err(UnitsError::Tau { tau });
                 }
                 (CS2 * (tau - 0.5) * inp.dx * inp.dx / inp.nu, tau)
             }
         };
-        if !(tau > 0.5) {
+        if tau.is_nan() || tau <= 0.5 {
             return Err(UnitsError::Tau { tau });
         }
         let cs = CS2.sqrt();
@@ -233,7 +233,10 @@ mod tests {
             let e = LatticeUnits::derive(&water(TimeSpec::Tau(tau), 0.0)).unwrap_err();
             assert!(matches!(e, UnitsError::Tau { .. }));
             let msg = e.to_string();
-            assert!(msg.contains("tau") && msg.contains("0.5") && msg.contains("raise"), "{msg}");
+            assert!(
+                msg.contains("tau") && msg.contains("0.5") && msg.contains("raise"),
+                "{msg}"
+            );
         }
     }
 
@@ -253,7 +256,10 @@ mod tests {
                 }
                 Err(e) => {
                     let msg = e.to_string();
-                    assert!(msg.contains("Mach") && msg.contains("0.3") && msg.contains("lower dt"), "{msg}");
+                    assert!(
+                        msg.contains("Mach") && msg.contains("0.3") && msg.contains("lower dt"),
+                        "{msg}"
+                    );
                     refused_at.get_or_insert(u);
                 }
             }

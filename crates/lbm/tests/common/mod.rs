@@ -30,7 +30,11 @@ pub fn run_steady<L: Lattice, T: Real>(
         }
         steps += every;
         if !prev.is_empty() {
-            let d = m.u.iter().zip(&prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let d =
+                m.u.iter()
+                    .zip(&prev)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
             if d < tol {
                 break;
             }
@@ -43,7 +47,17 @@ pub fn run_steady<L: Lattice, T: Real>(
 /// Channel periodic in x, walls at y = -1/2 and y = H - 1/2 (halfway bounce-back).
 pub fn channel(nx: usize, h: usize) -> Domain {
     let wall = Face::Wall { velocity: [0.0; 3] };
-    Domain::new([nx, h, 1], [Face::Periodic, Face::Periodic, wall, wall, Face::Periodic, Face::Periodic])
+    Domain::new(
+        [nx, h, 1],
+        [
+            Face::Periodic,
+            Face::Periodic,
+            wall,
+            wall,
+            Face::Periodic,
+            Face::Periodic,
+        ],
+    )
 }
 
 pub fn no_obstacles() -> Vec<Motion> {
