@@ -39,7 +39,16 @@ fn main() {
     let threads: usize = a.get(4).map_or(1, |s| s.parse().unwrap());
     let aa = a.get(5).is_none_or(|s| s == "aa");
     let steps = (100_000_000 / (nx * ny)).max(2) & !1;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    let m = pool.install(|| if f32s { run::<f32>(nx, ny, aa, steps) } else { run::<f64>(nx, ny, aa, steps) });
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let m = pool.install(|| {
+        if f32s {
+            run::<f32>(nx, ny, aa, steps)
+        } else {
+            run::<f64>(nx, ny, aa, steps)
+        }
+    });
     println!("{nx}x{ny} f32={f32s} threads={threads} aa={aa}: {m:.1} MLUPS");
 }

@@ -151,12 +151,16 @@ pub fn collide_block<L: Lattice, T: Real, const W: usize>(
         for a in 0..L::D {
             cf += T::from_f64(c[a] as f64) * p.force[a];
         }
+        let (cx, cy, cz) = (
+            T::from_f64(c[0] as f64),
+            T::from_f64(c[1] as f64),
+            T::from_f64(c[2] as f64),
+        );
         for w in 0..W {
-            let mut cu = zero;
-            for a in 0..L::D {
-                if c[a] != 0 {
-                    cu += T::from_f64(c[a] as f64) * u[a][w];
-                }
+            // L::D is a constant: the z term vanishes at compile time in 2D
+            let mut cu = cx * u[0][w] + cy * u[1][w];
+            if L::D == 3 {
+                cu += cz * u[2][w];
             }
             let wr = wi * rho[w];
             let feq_s = wr * (one + c45 * cu * cu - c15 * usq[w]);

@@ -85,6 +85,8 @@ pub unsafe fn even_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
     let mut bad = None;
     let kind = &dom.kind[row_off..row_off + nx];
     let mut x = 0;
+    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
+    let mut f = [[T::default(); W]; QMAX];
     while x < nx {
         if kind[x] != FLUID {
             x += 1;
@@ -96,7 +98,6 @@ pub unsafe fn even_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
         }
         let mut xb = x0;
         while xb + W <= x {
-            let mut f = [[T::default(); W]; QMAX];
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
                 // SAFETY: in bounds, own nodes.
                 unsafe {
@@ -153,11 +154,12 @@ pub unsafe fn odd_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
         down[i] = (i * n + row_of(1)).wrapping_add(c[0] as isize as usize);
     }
     let plan = ctx.plan;
+    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
+    let mut f = [[T::default(); W]; QMAX];
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
         let (x0, x1) = (x0 as usize, x1 as usize);
         let mut xb = x0;
         while xb + W <= x1 {
-            let mut f = [[T::default(); W]; QMAX];
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
                 unsafe {
                     std::ptr::copy_nonoverlapping(ctx.f.0.add(up[i].wrapping_add(xb)), fi.as_mut_ptr(), W)
