@@ -96,7 +96,8 @@ pub struct Moments<T, const W: usize> {
 /// S_i = w_i[3(c_i − u) + 9 c_i (c_i·u)]·F (Leonardi Eq. 16) split into its even and odd parts.
 /// Written with the node index innermost over fixed-size local arrays so that it vectorises.
 #[inline(always)]
-pub fn collide_block<L: Lattice, T: Real, const W: usize>(
+/// `FORCED = false` drops the force terms at compile time (the result is the same for F = 0).
+pub fn collide_block<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
     f: &mut [[T; W]; QMAX],
     p: &CollideParams<T>,
 ) -> Moments<T, W> {
@@ -129,9 +130,15 @@ pub fn collide_block<L: Lattice, T: Real, const W: usize>(
     for w in 0..W {
         let inv = one / rho[w];
         for a in 0..L::D {
-            u[a][w] = (j[a][w] + half * p.force[a]) * inv;
+            u[a][w] = if FORCED {
+                (j[a][w] + half * p.force[a]) * inv
+            } else {
+                j[a][w] * inv
+            };
             usq[w] += u[a][w] * u[a][w];
-            uf[w] += u[a][w] * p.force[a];
+            if FORCED {
+                uf[w] += u[a][w] * p.force[a];
+            }
         }
     }
     // rest population: symmetric only
@@ -139,8 +146,11 @@ pub fn collide_block<L: Lattice, T: Real, const W: usize>(
         let w0 = T::from_f64(L::W[0]);
         for w in 0..W {
             let feq = w0 * rho[w] * (one - c15 * usq[w]);
-            let s = -w0 * three * uf[w];
-            f[0][w] = f[0][w] - p.omega_p * (f[0][w] - feq) + p.force_p * s;
+            f[0][w] = f[0][w] - p.omega_p * (f[0][w] - feq);
+            if FORCED {
+                let s = -w0 * three * uf[w];
+                f[0][w] += p.force_p * s;
+            }
         }
     }
     for &i in L::HALF {
@@ -165,12 +175,16 @@ pub fn collide_block<L: Lattice, T: Real, const W: usize>(
             let wr = wi * rho[w];
             let feq_s = wr * (one + c45 * cu * cu - c15 * usq[w]);
             let feq_a = wr * three * cu;
-            let s_s = wi * (nine * cu * cf - three * uf[w]);
-            let s_a = wi * three * cf;
             let fs = half * (f[i][w] + f[o][w]);
             let fa = half * (f[i][w] - f[o][w]);
-            let ns = fs - p.omega_p * (fs - feq_s) + p.force_p * s_s;
-            let na = fa - p.omega_m * (fa - feq_a) + p.force_m * s_a;
+            let mut ns = fs - p.omega_p * (fs - feq_s);
+            let mut na = fa - p.omega_m * (fa - feq_a);
+            if FORCED {
+                let s_s = wi * (nine * cu * cf - three * uf[w]);
+                let s_a = wi * three * cf;
+                ns += p.force_p * s_s;
+                na += p.force_m * s_a;
+            }
             f[i][w] = ns + na;
             f[o][w] = ns - na;
         }

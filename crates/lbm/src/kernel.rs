@@ -73,7 +73,7 @@ fn ok<T: Real>(rho: T, u: [T; 3], l: &Limits) -> bool {
 /// # Safety
 /// `ctx.dst` (and `ctx.out`) must point to arrays of the right length, and no other thread may
 /// write row `r` during the call.
-pub unsafe fn row<L: Lattice, T: Real>(ctx: &Ctx<T>, r: usize) -> bool {
+pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) -> bool {
     let dom = ctx.dom;
     let [nx, ny, _] = dom.n;
     let n = dom.len();
@@ -99,7 +99,7 @@ pub unsafe fn row<L: Lattice, T: Real>(ctx: &Ctx<T>, r: usize) -> bool {
                 let s = (up_off[i] as isize + xb as isize - L::C[i][0] as isize) as usize;
                 f[i].copy_from_slice(&ctx.src[s..s + W]);
             }
-            let m = collide_block::<L, T, W>(&mut f, &ctx.params);
+            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
             for i in 0..L::Q {
                 // SAFETY: row r is ours; i*n + row_off + xb + W <= Q n.
                 unsafe {
@@ -116,7 +116,7 @@ pub unsafe fn row<L: Lattice, T: Real>(ctx: &Ctx<T>, r: usize) -> bool {
                 let s = (up_off[i] as isize + xb as isize - L::C[i][0] as isize) as usize;
                 f[i][0] = ctx.src[s];
             }
-            let m = collide_block::<L, T, 1>(&mut f, &ctx.params);
+            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
             for i in 0..L::Q {
                 unsafe { *ctx.dst.0.add(i * n + row_off + xb) = f[i][0] };
             }
@@ -125,7 +125,7 @@ pub unsafe fn row<L: Lattice, T: Real>(ctx: &Ctx<T>, r: usize) -> bool {
         }
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
-        good &= unsafe { general_node::<L, T>(ctx, [x as usize, y, z]) };
+        good &= unsafe { general_node::<L, T, F>(ctx, [x as usize, y, z]) };
     }
     good
 }
@@ -152,7 +152,7 @@ fn finish_block<T: Real, const B: usize>(ctx: &Ctx<T>, m: &Moments<T, B>, idx0: 
 }
 
 /// One node next to a wall, an obstacle, a non-periodic face or a periodic x edge.
-unsafe fn general_node<L: Lattice, T: Real>(ctx: &Ctx<T>, p: [usize; 3]) -> bool {
+unsafe fn general_node<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, p: [usize; 3]) -> bool {
     let dom = ctx.dom;
     let n = dom.len();
     let idx = dom.index(p[0], p[1], p[2]);
@@ -210,7 +210,7 @@ unsafe fn general_node<L: Lattice, T: Real>(ctx: &Ctx<T>, p: [usize; 3]) -> bool
             }
         }
     }
-    let m = collide_block::<L, T, 1>(&mut f, &ctx.params);
+    let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
     for i in 0..L::Q {
         unsafe { *ctx.dst.0.add(i * n + idx) = f[i][0] };
     }

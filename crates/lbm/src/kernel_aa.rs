@@ -77,7 +77,7 @@ fn check<T: Real, const B: usize>(
 ///
 /// # Safety
 /// `ctx.f` must hold Q n values; no other thread may touch the nodes of row `r`.
-pub unsafe fn even_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
+pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
     let dom = ctx.dom;
     let nx = dom.n[0];
     let n = dom.len();
@@ -104,7 +104,7 @@ pub unsafe fn even_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
                     std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + row_off + xb), fi.as_mut_ptr(), W)
                 };
             }
-            let m = collide_block::<L, T, W>(&mut f, &ctx.params);
+            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
                 let o = L::OPP[i];
                 unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(o * n + row_off + xb), W) };
@@ -117,7 +117,7 @@ pub unsafe fn even_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
                 fi[0] = unsafe { *ctx.f.0.add(i * n + row_off + xb) };
             }
-            let m = collide_block::<L, T, 1>(&mut f, &ctx.params);
+            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
                 unsafe { *ctx.f.0.add(L::OPP[i] * n + row_off + xb) = fi[0] };
             }
@@ -133,7 +133,7 @@ pub unsafe fn even_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
 /// # Safety
 /// As `even_row`; the slots a node touches are its own (see the module doc), so rows may run
 /// concurrently.
-pub unsafe fn odd_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
+pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
     let dom = ctx.dom;
     let [nx, ny, nz] = dom.n;
     let n = dom.len();
@@ -165,7 +165,7 @@ pub unsafe fn odd_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
                     std::ptr::copy_nonoverlapping(ctx.f.0.add(up[i].wrapping_add(xb)), fi.as_mut_ptr(), W)
                 };
             }
-            let m = collide_block::<L, T, W>(&mut f, &ctx.params);
+            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
                 unsafe {
                     std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(down[i].wrapping_add(xb)), W)
@@ -179,7 +179,7 @@ pub unsafe fn odd_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
                 fi[0] = unsafe { *ctx.f.0.add(up[i].wrapping_add(xb)) };
             }
-            let m = collide_block::<L, T, 1>(&mut f, &ctx.params);
+            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
                 unsafe { *ctx.f.0.add(down[i].wrapping_add(xb)) = fi[0] };
             }
@@ -188,7 +188,7 @@ pub unsafe fn odd_row<L: Lattice, T: Real>(ctx: &CtxAa<T>, r: usize) -> Bad {
         }
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
-        unsafe { odd_general::<L, T>(ctx, [x as usize, y, z], &mut bad) };
+        unsafe { odd_general::<L, T, F>(ctx, [x as usize, y, z], &mut bad) };
     }
     bad
 }
@@ -206,7 +206,7 @@ fn wall_velocity(ctx: &CtxAa<impl Real>, p: [usize; 3], c: [i32; 3], sign: f64, 
     }
 }
 
-unsafe fn odd_general<L: Lattice, T: Real>(ctx: &CtxAa<T>, p: [usize; 3], bad: &mut Bad) {
+unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [usize; 3], bad: &mut Bad) {
     let dom = ctx.dom;
     let n = dom.len();
     let idx = dom.index(p[0], p[1], p[2]);
@@ -231,7 +231,7 @@ unsafe fn odd_general<L: Lattice, T: Real>(ctx: &CtxAa<T>, p: [usize; 3], bad: &
             },
         };
     }
-    let m = collide_block::<L, T, 1>(&mut f, &ctx.params);
+    let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
     for (i, fi) in f.iter().enumerate().take(L::Q) {
         let c = L::C[i];
         let o = L::OPP[i];

@@ -215,13 +215,21 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             limits: self.settings.limits,
             out,
         };
+        let forced = self.settings.force.iter().any(|&x| x != 0.0);
         self.row_good
             .par_chunks_mut(ROWS_PER_TASK)
             .enumerate()
             .for_each(|(c, flags)| {
                 for (k, g) in flags.iter_mut().enumerate() {
+                    let r = c * ROWS_PER_TASK + k;
                     // SAFETY: each row index belongs to exactly one chunk.
-                    *g = unsafe { kernel::row::<L, T>(&ctx, c * ROWS_PER_TASK + k) };
+                    *g = unsafe {
+                        if forced {
+                            kernel::row::<L, T, true>(&ctx, r)
+                        } else {
+                            kernel::row::<L, T, false>(&ctx, r)
+                        }
+                    };
                 }
             });
         std::mem::swap(&mut fluid.f, &mut self.other);

@@ -116,6 +116,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             out,
         };
         let odd = self.reversed;
+        let forced = self.settings.force.iter().any(|&x| x != 0.0);
         self.bad
             .par_chunks_mut(ROWS_PER_TASK)
             .enumerate()
@@ -124,10 +125,11 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
                     let r = c * ROWS_PER_TASK + k;
                     // SAFETY: every node touches only its own slots (kernel_aa module doc).
                     *b = unsafe {
-                        if odd {
-                            kernel_aa::odd_row::<L, T>(&ctx, r)
-                        } else {
-                            kernel_aa::even_row::<L, T>(&ctx, r)
+                        match (odd, forced) {
+                            (true, true) => kernel_aa::odd_row::<L, T, true>(&ctx, r),
+                            (true, false) => kernel_aa::odd_row::<L, T, false>(&ctx, r),
+                            (false, true) => kernel_aa::even_row::<L, T, true>(&ctx, r),
+                            (false, false) => kernel_aa::even_row::<L, T, false>(&ctx, r),
                         }
                     };
                 }
