@@ -14,7 +14,13 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENV="${LBMPY_VENV:-$ROOT/target/peer-lbmpy-venv}"
-BENCH="${LBMPY_BENCH:-$ROOT/../shared/peers/lbmpy_bench.py}"
+# ../shared/peers from the main checkout (/work/main); ../../shared/peers from a worktree (/work/wt/x)
+BENCH="${LBMPY_BENCH:-}"
+if [ -z "$BENCH" ]; then
+    for d in "$ROOT/../shared/peers" "$ROOT/../../shared/peers"; do
+        if [ -f "$d/lbmpy_bench.py" ]; then BENCH="$d/lbmpy_bench.py"; break; fi
+    done
+fi
 PY="$VENV/bin/python"
 
 install() {
@@ -30,7 +36,7 @@ if [ $# -lt 3 ]; then
     echo "usage: $0 SIZE DTYPE THREADS [VARIANT]   or   $0 install" >&2
     exit 2
 fi
-[ -f "$BENCH" ] || { echo "peer-lbmpy: driver $BENCH not found; set LBMPY_BENCH" >&2; exit 2; }
+[ -n "$BENCH" ] && [ -f "$BENCH" ] || { echo "peer-lbmpy: driver lbmpy_bench.py not found in ../shared/peers or ../../shared/peers; set LBMPY_BENCH=path" >&2; exit 2; }
 install
 SIZE="$1" DTYPE="$2" THREADS="$3" VARIANT="${4:-aa}"
 export OMP_PROC_BIND=close OMP_PLACES=cores
