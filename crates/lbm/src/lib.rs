@@ -1,1 +1,55 @@
-//! placeholder: see the crate's issue
+//! lbdem-lbm: the lattice-Boltzmann engine (issue 3).
+//!
+//! D2Q9 and D3Q19 lattices behind one trait of constants ([`lattice`]), BGK and TRT collision
+//! with Guo forcing ([`collision`]), a fused stream-collide kernel over structure-of-arrays storage
+//! in f32 or f64 ([`kernel`]), halfway bounce-back on stationary and moving walls with the
+//! momentum-exchange force and torque, Zou-He velocity and pressure faces, periodic faces, and a
+//! stepper that stops at the first node leaving the accepted range with a diagnosis ([`stepper`]).
+//! Pure computation: no file I/O; units are converted in `lbdem_core::units::lattice`.
+
+// Kernels index several parallel arrays (velocities, weights, populations) by direction: an index
+// loop says that more plainly than zipped iterators.
+#![allow(clippy::needless_range_loop)]
+
+pub mod collision;
+pub mod domain;
+pub mod kernel;
+pub mod kernel_aa;
+pub mod lattice;
+pub mod plan;
+pub mod real;
+pub mod stepper;
+pub mod stepper_aa;
+pub mod zouhe;
+
+pub use collision::Collision;
+pub use domain::{Domain, Face, Motion};
+pub use kernel::Limits;
+pub use lattice::{D2Q9, D3Q19, Lattice};
+pub use real::Real;
+pub use stepper::{Fluid, ForceTorque, Macro, Settings, Stepper};
+pub use stepper_aa::StepperAa;
+
+/// Errors of the LBM engine; each names the parameter, its value, the limit and the fix.
+#[derive(Debug, thiserror::Error)]
+pub enum LbmError {
+    #[error(
+        "relaxation time tau = {tau} must be > 0.5 (zero or negative viscosity, Su et al. 2020 Eq. 15); \
+         increase the viscosity or the time step, or refine dx"
+    )]
+    Tau { tau: f64 },
+    #[error("TRT magic parameter = {magic} must be > 0; use 0.25 (stability) or 3/16 (exact walls)")]
+    Magic { magic: f64 },
+    #[error("unsupported set-up: {0}")]
+    Unsupported(String),
+    #[error(
+        "run unstable at step {step}, node {node:?}: density {rho:.6}, velocity {u:?}; likely cause: {cause}"
+    )]
+    Unstable {
+        step: u64,
+        node: [usize; 3],
+        rho: f64,
+        u: [f64; 3],
+        cause: String,
+    },
+}

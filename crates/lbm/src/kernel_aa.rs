@@ -1,0 +1,250 @@
+//! In-place AA-pattern stream-collide (Bailey et al., ICPP 2009) over one structure-of-arrays
+//! population array: half the memory traffic of the two-array pull kernel (no second array, no
+//! write-allocate), the way lbmpy's fastest variant works.
+//!
+//! The array alternates between two layouts. "Reversed": slot `opp(i)` of node x holds the
+//! post-collision f_i(x) (what the two-array kernel keeps in slot i). An odd step (`odd_row`)
+//! gathers f_i(y) from slot `opp(i)` of y − c_i (or, across a wall, slot i of y itself plus the
+//! moving-wall term of Leonardi Eq. 19), collides, and scatters f_i to slot i of y + c_i (or,
+//! towards a wall, to slot opp(i) of y with the wall term): the array is then "natural", slot i of
+//! x = pre-collision f_i(x). An even step (`even_row`) is purely local: read slot i, collide, write
+//! slot opp(i): back to "reversed". Each node reads and writes exactly the same set of slots, so
+//! nodes are independent and rows can run on any thread. The bounce-back arithmetic is written
+//! exactly as in the two-array kernel, so both give bitwise-identical results.
+
+use crate::collision::{CollideParams, Moments, collide_block};
+use crate::domain::{Domain, FLUID, Motion};
+use crate::kernel::{Limits, MacroOut, SyncPtr, W};
+use crate::lattice::{Lattice, QMAX};
+use crate::plan::{Plan, Upstream, neighbour};
+use crate::real::Real;
+
+/// First node of a row that left the limits: (x, ρ, u).
+pub type Bad = Option<(usize, f64, [f64; 3])>;
+
+pub struct CtxAa<'a, T> {
+    pub dom: &'a Domain,
+    pub plan: &'a Plan,
+    /// The single population array (read and written through raw pointers only).
+    pub f: SyncPtr<T>,
+    pub params: CollideParams<T>,
+    pub motions: &'a [Motion],
+    pub limits: Limits,
+    pub out: Option<MacroOut>,
+}
+
+#[inline(always)]
+fn check<T: Real, const B: usize>(
+    ctx: &CtxAa<T>,
+    m: &Moments<T, B>,
+    idx0: usize,
+    count: usize,
+    bad: &mut Bad,
+) {
+    let l = &ctx.limits;
+    let mut any = false;
+    for w in 0..count {
+        let usq = (m.u[0][w] * m.u[0][w] + m.u[1][w] * m.u[1][w] + m.u[2][w] * m.u[2][w]).to_f64();
+        let r = m.rho[w].to_f64();
+        any |= !(r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max);
+    }
+    if any && bad.is_none() {
+        for w in 0..count {
+            let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
+            let r = m.rho[w].to_f64();
+            let usq = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+            if !(r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max) {
+                *bad = Some(((idx0 + w) % ctx.dom.n[0], r, u));
+                break;
+            }
+        }
+    }
+    if let Some(o) = ctx.out {
+        for w in 0..count {
+            let idx = idx0 + w;
+            // SAFETY: node idx belongs to the calling row.
+            unsafe {
+                *o.rho.0.add(idx) = m.rho[w].to_f64();
+                for a in 0..3 {
+                    *o.u.0.add(3 * idx + a) = m.u[a][w].to_f64();
+                }
+            }
+        }
+    }
+}
+
+/// Even step of row `r`: local collide, slot i -> slot opp(i), over every fluid run of the row.
+///
+/// # Safety
+/// `ctx.f` must hold Q n values; no other thread may touch the nodes of row `r`.
+pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
+    let dom = ctx.dom;
+    let nx = dom.n[0];
+    let n = dom.len();
+    let row_off = r * nx;
+    let mut bad = None;
+    let kind = &dom.kind[row_off..row_off + nx];
+    let mut x = 0;
+    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
+    let mut f = [[T::default(); W]; QMAX];
+    while x < nx {
+        if kind[x] != FLUID {
+            x += 1;
+            continue;
+        }
+        let x0 = x;
+        while x < nx && kind[x] == FLUID {
+            x += 1;
+        }
+        let mut xb = x0;
+        while xb + W <= x {
+            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+                // SAFETY: in bounds, own nodes.
+                unsafe {
+                    std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + row_off + xb), fi.as_mut_ptr(), W)
+                };
+            }
+            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
+            for (i, fi) in f.iter().enumerate().take(L::Q) {
+                let o = L::OPP[i];
+                unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(o * n + row_off + xb), W) };
+            }
+            check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
+            xb += W;
+        }
+        while xb < x {
+            let mut f = [[T::default(); 1]; QMAX];
+            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+                fi[0] = unsafe { *ctx.f.0.add(i * n + row_off + xb) };
+            }
+            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+            for (i, fi) in f.iter().enumerate().take(L::Q) {
+                unsafe { *ctx.f.0.add(L::OPP[i] * n + row_off + xb) = fi[0] };
+            }
+            check::<T, 1>(ctx, &m, row_off + xb, 1, &mut bad);
+            xb += 1;
+        }
+    }
+    bad
+}
+
+/// Odd step of row `r`: gather from neighbours, collide, scatter to neighbours.
+///
+/// # Safety
+/// As `even_row`; the slots a node touches are its own (see the module doc), so rows may run
+/// concurrently.
+pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
+    let dom = ctx.dom;
+    let [nx, ny, nz] = dom.n;
+    let n = dom.len();
+    let (y, z) = (r % ny, r / ny);
+    let row_off = r * nx;
+    let mut bad = None;
+    let mut up = [0usize; QMAX];
+    let mut down = [0usize; QMAX];
+    for i in 0..L::Q {
+        let c = L::C[i];
+        let row_of = |s: i64| {
+            let ys = (y as i64 + s * c[1] as i64).rem_euclid(ny as i64) as usize;
+            let zs = (z as i64 + s * c[2] as i64).rem_euclid(nz as i64) as usize;
+            (ys + ny * zs) * nx
+        };
+        // read slot opp(i) of y - c_i; write slot i of y + c_i
+        up[i] = (L::OPP[i] * n + row_of(-1)).wrapping_sub(c[0] as isize as usize);
+        down[i] = (i * n + row_of(1)).wrapping_add(c[0] as isize as usize);
+    }
+    let plan = ctx.plan;
+    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
+    let mut f = [[T::default(); W]; QMAX];
+    for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
+        let (x0, x1) = (x0 as usize, x1 as usize);
+        let mut xb = x0;
+        while xb + W <= x1 {
+            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+                unsafe {
+                    std::ptr::copy_nonoverlapping(ctx.f.0.add(up[i].wrapping_add(xb)), fi.as_mut_ptr(), W)
+                };
+            }
+            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
+            for (i, fi) in f.iter().enumerate().take(L::Q) {
+                unsafe {
+                    std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(down[i].wrapping_add(xb)), W)
+                };
+            }
+            check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
+            xb += W;
+        }
+        while xb < x1 {
+            let mut f = [[T::default(); 1]; QMAX];
+            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+                fi[0] = unsafe { *ctx.f.0.add(up[i].wrapping_add(xb)) };
+            }
+            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+            for (i, fi) in f.iter().enumerate().take(L::Q) {
+                unsafe { *ctx.f.0.add(down[i].wrapping_add(xb)) = fi[0] };
+            }
+            check::<T, 1>(ctx, &m, row_off + xb, 1, &mut bad);
+            xb += 1;
+        }
+    }
+    for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
+        unsafe { odd_general::<L, T, F>(ctx, [x as usize, y, z], &mut bad) };
+    }
+    bad
+}
+
+/// Wall velocity at the link midpoint p + s c/2 towards a solid node `s_idx` (obstacle or inactive).
+fn wall_velocity(ctx: &CtxAa<impl Real>, p: [usize; 3], c: [i32; 3], sign: f64, s_idx: usize) -> [f64; 3] {
+    let dom = ctx.dom;
+    let id = dom.obstacle[s_idx] as usize;
+    if id < ctx.motions.len() - 6 {
+        let m = &ctx.motions[id];
+        let mid = [0, 1, 2].map(|a| p[a] as f64 + sign * 0.5 * c[a] as f64);
+        m.velocity_at(dom.offset(m.centre, mid))
+    } else {
+        [0.0; 3]
+    }
+}
+
+unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [usize; 3], bad: &mut Bad) {
+    let dom = ctx.dom;
+    let n = dom.len();
+    let idx = dom.index(p[0], p[1], p[2]);
+    let n_obst = ctx.motions.len() - 6;
+    let dotw = |i: usize, u: [f64; 3]| {
+        let c = L::C[i];
+        6.0 * L::W[i] * (c[0] as f64 * u[0] + c[1] as f64 * u[1] + c[2] as f64 * u[2])
+    };
+    let face_velocity = |fc: usize| ctx.motions[n_obst + fc].velocity;
+    let mut f = [[T::default(); 1]; QMAX];
+    for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+        let c = L::C[i];
+        // SAFETY (all raw accesses): indices in bounds; slots owned by this node.
+        fi[0] = match neighbour(dom, p, [-c[0], -c[1], -c[2]]) {
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(L::OPP[i] * n + s) },
+            Upstream::Node(s) => {
+                let uw = wall_velocity(ctx, p, c, -1.0, s);
+                unsafe { *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, uw)) }
+            }
+            Upstream::Face(fc) => unsafe {
+                *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, face_velocity(fc)))
+            },
+        };
+    }
+    let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+    for (i, fi) in f.iter().enumerate().take(L::Q) {
+        let c = L::C[i];
+        let o = L::OPP[i];
+        match neighbour(dom, p, c) {
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(i * n + s) = fi[0] },
+            Upstream::Node(s) => {
+                let uw = wall_velocity(ctx, p, c, 1.0, s);
+                unsafe { *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, uw)) }
+            }
+            Upstream::Face(fc) => unsafe {
+                *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, face_velocity(fc)))
+            },
+        }
+    }
+    check::<T, 1>(ctx, &m, idx, 1, bad);
+}

@@ -1,0 +1,362 @@
+//! State and stepper. `Fluid` is plain data (the domain, the post-collision populations f in
+//! structure-of-arrays order `f[i * n + node]`, obstacle motions); `Stepper` is scratch (the second
+//! population array, the row plan, per-row flags) plus the step loop: momentum-exchange forces,
+//! fused stream-collide on a caller-chosen rayon pool, and the instability check.
+
+use crate::LbmError;
+use crate::collision::{CollideParams, Collision, equilibrium};
+use crate::domain::{Domain, FLUID, Face, Motion};
+use crate::kernel::{self, Ctx, Limits, MacroOut, SyncPtr};
+use crate::lattice::{Lattice, QMAX};
+use crate::plan::Plan;
+use crate::real::Real;
+use rayon::prelude::*;
+use std::marker::PhantomData;
+
+/// Hydrodynamic force and torque on one obstacle (lattice units, Leonardi Eq. 21).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ForceTorque {
+    pub force: [f64; 3],
+    pub torque: [f64; 3],
+}
+
+/// Lattice state: plain data the coupling code may read and modify between steps.
+#[derive(Clone, Debug)]
+pub struct Fluid<L: Lattice, T: Real> {
+    pub domain: Domain,
+    /// Post-collision populations of the current time, `f[i * n + node]`.
+    pub f: Vec<T>,
+    /// Rigid motion of each obstacle (index = obstacle id).
+    pub obstacles: Vec<Motion>,
+    /// Completed steps.
+    pub step: u64,
+    _l: PhantomData<L>,
+}
+
+impl<L: Lattice, T: Real> Fluid<L, T> {
+    /// Fluid at rest with density 1 on every node.
+    pub fn new(domain: Domain, obstacles: Vec<Motion>) -> Self {
+        let n = domain.len();
+        let mut f = vec![T::default(); L::Q * n];
+        for i in 0..L::Q {
+            f[i * n..(i + 1) * n].fill(T::from_f64(L::W[i]));
+        }
+        Self {
+            domain,
+            f,
+            obstacles,
+            step: 0,
+            _l: PhantomData,
+        }
+    }
+    pub fn nodes(&self) -> usize {
+        self.domain.len()
+    }
+    /// Set every fluid node to the equilibrium of `init(node) = (ρ, u)` (Su Eq. 7).
+    pub fn init_equilibrium(&mut self, init: impl Fn([usize; 3]) -> (f64, [f64; 3])) {
+        let n = self.nodes();
+        for idx in 0..n {
+            let (rho, u) = init(self.domain.coords(idx));
+            let feq = equilibrium::<L>(rho, u);
+            for (i, v) in feq.iter().enumerate().take(L::Q) {
+                self.f[i * n + idx] = T::from_f64(*v);
+            }
+        }
+    }
+    /// Density and momentum Σ f c of node `idx` from the stored (post-collision) populations.
+    pub fn moments(&self, idx: usize) -> (f64, [f64; 3]) {
+        let n = self.nodes();
+        let mut rho = 0.0;
+        let mut j = [0.0; 3];
+        for i in 0..L::Q {
+            let v = self.f[i * n + idx].to_f64();
+            rho += v;
+            for (a, ja) in j.iter_mut().enumerate() {
+                *ja += v * L::C[i][a] as f64;
+            }
+        }
+        (rho, j)
+    }
+}
+
+/// Macroscopic fields of the last step (written by the kernel when asked).
+#[derive(Clone, Debug, Default)]
+pub struct Macro {
+    pub rho: Vec<f64>,
+    /// Interleaved xyz.
+    pub u: Vec<f64>,
+}
+
+/// Settings of a run that do not change from step to step.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    pub collision: Collision,
+    /// Uniform body-force density on fluid nodes (lattice units).
+    pub force: [f64; 3],
+    pub limits: Limits,
+}
+
+/// Scratch and the step loop.
+pub struct Stepper<L: Lattice, T: Real> {
+    settings: Settings,
+    params: CollideParams<T>,
+    plan: Plan,
+    other: Vec<T>,
+    row_good: Vec<bool>,
+    motions: Vec<Motion>,
+    /// Forces of the last step on each obstacle, then on each of the six faces.
+    pub forces: Vec<ForceTorque>,
+    _l: PhantomData<L>,
+}
+
+/// Rows per rayon task: fixed, so work splitting is the same for every pool size.
+const ROWS_PER_TASK: usize = 4;
+
+impl<L: Lattice, T: Real> Stepper<L, T> {
+    /// Check the settings against the domain and build the row plan.
+    pub fn new(fluid: &Fluid<L, T>, settings: Settings) -> Result<Self, LbmError> {
+        let params = CollideParams::<T>::new(&settings.collision, settings.force)?;
+        let dom = &fluid.domain;
+        if (L::D == 2) != (dom.n[2] == 1) {
+            return Err(LbmError::Unsupported(format!(
+                "lattice {} on a box of {}x{}x{} nodes: use nz = 1 with D2Q9 and nz > 1 with D3Q19",
+                L::NAME,
+                dom.n[0],
+                dom.n[1],
+                dom.n[2]
+            )));
+        }
+        for (k, fc) in dom.faces.iter().enumerate() {
+            if fc.is_zou_he() && (L::D != 2 || k >= 4) {
+                return Err(LbmError::Unsupported(format!(
+                    "Zou-He {:?} on face {k} with {}: only D2Q9 x/y faces are implemented; use a wall, \
+                     periodic faces or a body force",
+                    fc,
+                    L::NAME
+                )));
+            }
+            let opp = k ^ 1;
+            if fc.is_periodic() != dom.faces[opp].is_periodic() {
+                return Err(LbmError::Unsupported(format!(
+                    "face {k} is {:?} but the opposite face is not periodic: make both periodic or neither",
+                    fc
+                )));
+            }
+        }
+        if dom
+            .obstacle
+            .iter()
+            .any(|&o| o != u16::MAX && o as usize >= fluid.obstacles.len())
+        {
+            return Err(LbmError::Unsupported(
+                "a node is marked with an obstacle id that has no motion entry; push a Motion per obstacle"
+                    .into(),
+            ));
+        }
+        let mut s = Self {
+            settings,
+            params,
+            plan: Plan::default(),
+            other: vec![T::default(); fluid.f.len()],
+            row_good: vec![true; dom.n[1] * dom.n[2]],
+            motions: Vec::new(),
+            forces: Vec::new(),
+            _l: PhantomData,
+        };
+        s.rebuild(fluid);
+        Ok(s)
+    }
+
+    /// Rebuild the plan after the geometry (node kinds) changed.
+    pub fn rebuild(&mut self, fluid: &Fluid<L, T>) {
+        self.plan = Plan::build::<L>(&fluid.domain, fluid.obstacles.len());
+        self.forces = vec![ForceTorque::default(); fluid.obstacles.len() + 6];
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+    pub fn plan(&self) -> &Plan {
+        &self.plan
+    }
+
+    /// Advance one step on the current rayon pool. Forces on obstacles and walls are left in
+    /// `self.forces`; if `out` is given it receives ρ and u of every fluid node.
+    pub fn step(&mut self, fluid: &mut Fluid<L, T>, out: Option<&mut Macro>) -> Result<(), LbmError> {
+        self.exchange_forces(fluid);
+        let n = fluid.nodes();
+        self.motions.clear();
+        self.motions.extend_from_slice(&fluid.obstacles);
+        for fc in fluid.domain.faces {
+            let velocity = match fc {
+                Face::Wall { velocity } => velocity,
+                _ => [0.0; 3],
+            };
+            self.motions.push(Motion {
+                velocity,
+                ..Default::default()
+            });
+        }
+        let out = out.map(|m| {
+            m.rho.resize(n, 0.0);
+            m.u.resize(3 * n, 0.0);
+            MacroOut {
+                rho: SyncPtr(m.rho.as_mut_ptr()),
+                u: SyncPtr(m.u.as_mut_ptr()),
+            }
+        });
+        let ctx = Ctx {
+            dom: &fluid.domain,
+            plan: &self.plan,
+            src: &fluid.f,
+            dst: SyncPtr(self.other.as_mut_ptr()),
+            params: self.params,
+            motions: &self.motions,
+            limits: self.settings.limits,
+            out,
+        };
+        let forced = self.settings.force.iter().any(|&x| x != 0.0);
+        self.row_good
+            .par_chunks_mut(ROWS_PER_TASK)
+            .enumerate()
+            .for_each(|(c, flags)| {
+                for (k, g) in flags.iter_mut().enumerate() {
+                    let r = c * ROWS_PER_TASK + k;
+                    // SAFETY: each row index belongs to exactly one chunk.
+                    *g = unsafe {
+                        if forced {
+                            kernel::row::<L, T, true>(&ctx, r)
+                        } else {
+                            kernel::row::<L, T, false>(&ctx, r)
+                        }
+                    };
+                }
+            });
+        std::mem::swap(&mut fluid.f, &mut self.other);
+        fluid.step += 1;
+        if let Some(r) = self.row_good.iter().position(|g| !g) {
+            return Err(self.diagnose(fluid, r));
+        }
+        Ok(())
+    }
+
+    /// Momentum exchange on every boundary link from the post-collision populations about to be
+    /// bounced back: F = Σ (2 f_i − 6 w_i ρ u_w·c_i) c_i (Leonardi Eq. 21), torque Σ r × F with r
+    /// from the obstacle centre to the link midpoint. Sequential in link order (deterministic).
+    fn exchange_forces(&mut self, fluid: &Fluid<L, T>) {
+        let n = fluid.nodes();
+        let dom = &fluid.domain;
+        let n_obst = fluid.obstacles.len();
+        self.forces.iter_mut().for_each(|f| *f = ForceTorque::default());
+        for l in &self.plan.links {
+            if l.target == u16::MAX {
+                continue;
+            }
+            let i = l.dir as usize;
+            let c = L::C[i];
+            let p = dom.coords(l.node as usize);
+            let mid = [0, 1, 2].map(|a| p[a] as f64 + 0.5 * c[a] as f64);
+            let t = l.target as usize;
+            let (uw, r) = if t < n_obst {
+                let m = &fluid.obstacles[t];
+                let r = dom.offset(m.centre, mid);
+                (m.velocity_at(r), r)
+            } else {
+                let uw = match dom.faces[t - n_obst] {
+                    Face::Wall { velocity } => velocity,
+                    _ => [0.0; 3],
+                };
+                (uw, [0.0; 3])
+            };
+            let cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1] + c[2] as f64 * uw[2];
+            let mag = 2.0 * fluid.f[i * n + l.node as usize].to_f64() - 6.0 * L::W[i] * cu;
+            let fl = c.map(|ca| mag * ca as f64);
+            let ft = &mut self.forces[t];
+            for a in 0..3 {
+                ft.force[a] += fl[a];
+            }
+            ft.torque[0] += r[1] * fl[2] - r[2] * fl[1];
+            ft.torque[1] += r[2] * fl[0] - r[0] * fl[2];
+            ft.torque[2] += r[0] * fl[1] - r[1] * fl[0];
+        }
+    }
+
+    /// Find the first bad node of row `r` and name the likely cause.
+    fn diagnose(&self, fluid: &Fluid<L, T>, r: usize) -> LbmError {
+        let dom = &fluid.domain;
+        let [nx, ny, _] = dom.n;
+        let (y, z) = (r % ny, r / ny);
+        let lim = self.settings.limits;
+        let tau = self.settings.collision.tau();
+        for x in 0..nx {
+            let idx = dom.index(x, y, z);
+            if dom.kind[idx] != FLUID {
+                continue;
+            }
+            // recompute the macroscopic state of this node from the new post-collision values:
+            // ρ is unchanged by collision, u = (Σ f c − F/2)/ρ undoes the Guo half-force.
+            let (rho, j) = fluid.moments(idx);
+            let u = [0, 1, 2].map(|a| (j[a] - 0.5 * self.settings.force[a]) / rho);
+            let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            let finite = rho.is_finite() && speed.is_finite();
+            if finite && rho > lim.rho_min && rho < lim.rho_max && speed < lim.u_max {
+                continue;
+            }
+            let cause = likely_cause(tau, rho, u, &lim);
+            return LbmError::Unstable {
+                step: fluid.step,
+                node: [x, y, z],
+                rho,
+                u,
+                cause,
+            };
+        }
+        LbmError::Unstable {
+            step: fluid.step,
+            node: [0, y, z],
+            rho: f64::NAN,
+            u: [f64::NAN; 3],
+            cause: "row flagged but no bad node found (internal)".into(),
+        }
+    }
+}
+
+/// The likely cause of a node leaving the limits, with the fix.
+pub(crate) fn likely_cause(tau: f64, rho: f64, u: [f64; 3], lim: &Limits) -> String {
+    let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    let finite = rho.is_finite() && speed.is_finite();
+    let mach = speed / (1.0f64 / 3.0).sqrt();
+    if !finite && tau < 0.55 {
+        format!(
+            "relaxation time tau = {tau:.4} is close to 0.5 (under-resolved viscosity); raise tau \
+             (larger viscosity or time step relative to dx^2) or use TRT"
+        )
+    } else if speed >= lim.u_max || (!finite && mach > 0.3) {
+        format!(
+            "local Mach number |u|/c_s = {mach:.3} beyond the limit {:.3}: lower the velocity in \
+             lattice units (smaller time step or coarser dx)",
+            lim.u_max / (1.0f64 / 3.0).sqrt()
+        )
+    } else if finite {
+        format!(
+            "density {rho:.4} outside [{}, {}]: compressibility error from a too large pressure \
+             drop or velocity; lower the driving (force, pressure, velocity) in lattice units",
+            lim.rho_min, lim.rho_max
+        )
+    } else {
+        format!(
+            "non-finite value with tau = {tau:.4}: the run went unstable (most often tau near 0.5 \
+             or Mach too high); raise tau, refine the lattice or lower the velocity"
+        )
+    }
+}
+
+/// Populations of one node in f64 (for tests and coupling code).
+pub fn node_populations<L: Lattice, T: Real>(fluid: &Fluid<L, T>, idx: usize) -> [f64; QMAX] {
+    let n = fluid.nodes();
+    let mut out = [0.0; QMAX];
+    for (i, o) in out.iter_mut().enumerate().take(L::Q) {
+        *o = fluid.f[i * n + idx].to_f64();
+    }
+    out
+}
