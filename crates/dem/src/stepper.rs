@@ -1,0 +1,445 @@
+//! The time step: velocity Verlet for translation and rotation (Verlet 1967; Allen & Tildesley,
+//! "Computer Simulation of Liquids", Sect. 3.2), with optional viscous and local (non-viscous,
+//! Cundall) damping. The stepper holds only scratch; all state lives in [`System`].
+//!
+//! Determinism: pair forces are computed per pair in parallel into a per-pair buffer, then each
+//! body gathers its pairs in canonical order; every other reduction runs in a fixed order, so
+//! results are bitwise identical for any number of threads.
+
+use crate::contact::{ContactInput, ContactLaw, History};
+use crate::error::DemError;
+use crate::neighbor::{CellList, carry_history};
+use crate::system::System;
+use crate::vector::{Vec2, Vector};
+use crate::wall::update_wall_velocities;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepParams {
+    pub dt: f64,
+    #[serde(default)]
+    pub gravity: Vec2,
+    /// Factor on gravity: 1 for dry grains, 1 − ρ_L/ρ_S for buoyant grains in a liquid.
+    #[serde(default = "one")]
+    pub gravity_factor: f64,
+    /// Viscous damping rate γ (1/s): F −= γ m v, T −= γ I ω.
+    #[serde(default)]
+    pub viscous_damping: f64,
+    /// Local (non-viscous) damping α (Cundall): F_k −= α |F_k| sign(v_k).
+    #[serde(default)]
+    pub local_damping: f64,
+    /// Verlet-list skin (m).
+    pub skin: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl StepParams {
+    pub fn new(dt: f64, skin: f64) -> Self {
+        Self { dt, gravity: Vec2::ZERO, gravity_factor: 1.0, viscous_damping: 0.0, local_damping: 0.0, skin }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct PairOut {
+    f: Vec2,
+    ti: f64,
+    tj: f64,
+    touch: bool,
+}
+
+/// Scratch for stepping a [`System`].
+#[derive(Default)]
+pub struct Stepper {
+    cells: CellList,
+    cpos: Vec<Vec2>,
+    carm: Vec<Vec2>,
+    ref_pos: Vec<Vec2>,
+    out: Vec<PairOut>,
+    /// Per circle: entries into `out` (pair index << 1 | 1 if the circle is j).
+    csr_start: Vec<u32>,
+    csr: Vec<u32>,
+    wall_buf: Vec<(Vec2, f64)>,
+    n_circles: usize,
+    checked_dt: f64,
+    pub rebuilds: u64,
+}
+
+impl Stepper {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Critical time step of `sys` under `law` (and `wall_law`): sqrt(m_min / k_max).
+    pub fn critical_time_step<L: ContactLaw>(sys: &System, law: &L, wall_law: &L) -> (f64, f64, f64) {
+        let b = &sys.bodies;
+        let m_min = b.mass.iter().copied().fold(f64::INFINITY, f64::min);
+        let r_max = b.circle_r.iter().copied().fold(0.0, f64::max);
+        let mut k = law.max_stiffness(0.5 * r_max).max(wall_law.max_stiffness(r_max));
+        if let Some(p) = &sys.bond_params {
+            k = k.max(p.k_n.max(p.k_s) * 2.0 * p.lambda * r_max);
+        }
+        (lbdem_core::units::dem::critical_time_step(m_min, k), m_min, k)
+    }
+
+    /// Number of pairs in contact at the last force evaluation.
+    pub fn n_contacts(&self) -> usize {
+        self.out.iter().filter(|o| o.touch).count()
+    }
+
+    /// Advance `sys` by one step.
+    pub fn step<L: ContactLaw>(
+        &mut self,
+        p: &StepParams,
+        law: &L,
+        wall_law: &L,
+        sys: &mut System,
+    ) -> Result<(), DemError> {
+        let dt = p.dt;
+        if self.checked_dt != dt || self.n_circles != sys.bodies.n_circles() {
+            let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
+            if !(dt > 0.0) || dt > crit {
+                return Err(DemError::TimeStepTooLarge { dt, critical: crit, m_min, k_max });
+            }
+            self.checked_dt = dt;
+            let fresh = self.n_circles != sys.bodies.n_circles() || self.ref_pos.is_empty();
+            self.n_circles = sys.bodies.n_circles();
+            if fresh {
+                self.update_circles(sys);
+                self.rebuild(sys, p.skin)?;
+                if sys.step == 0 {
+                    // Prime F(0) for the first half-kick; dt = 0 leaves the history untouched.
+                    self.forces(&StepParams { dt: 0.0, ..*p }, law, wall_law, sys);
+                }
+            }
+        }
+        self.kick(sys, 0.5 * dt);
+        // Drift.
+        {
+            let b = &mut sys.bodies;
+            let dom = sys.domain;
+            b.pos.par_iter_mut().zip(b.vel.par_iter()).with_min_len(4096).for_each(|(x, v)| *x = dom.wrap(*x + *v * dt));
+            b.angle.par_iter_mut().zip(b.omega.par_iter()).with_min_len(4096).for_each(|(a, w)| *a += w * dt);
+        }
+        update_wall_velocities(&mut sys.walls);
+        for w in sys.walls.iter_mut() {
+            let v = w.vel;
+            w.translate(v * dt);
+        }
+        self.update_circles(sys);
+        let half_skin2 = 0.25 * p.skin * p.skin;
+        let dom = sys.domain;
+        let worst = self
+            .cpos
+            .par_iter()
+            .zip(self.ref_pos.par_iter())
+            .with_min_len(4096)
+            .map(|(a, b)| dom.min_image(*a - *b).norm2())
+            .reduce(|| 0.0, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) });
+        if !worst.is_finite() {
+            let body = (0..sys.bodies.len())
+                .find(|&k| !(sys.bodies.pos[k].norm2().is_finite() && sys.bodies.vel[k].norm2().is_finite()))
+                .unwrap_or(0);
+            return Err(DemError::NonFinite { body, step: sys.step });
+        }
+        if worst > half_skin2 {
+            self.rebuild(sys, p.skin)?;
+        }
+        self.forces(p, law, wall_law, sys);
+        self.kick(sys, 0.5 * dt);
+        sys.time += dt;
+        sys.step += 1;
+        Ok(())
+    }
+
+    fn kick(&self, sys: &mut System, h: f64) {
+        let b = &mut sys.bodies;
+        b.vel
+            .par_iter_mut()
+            .zip(b.force.par_iter().zip(b.mass.par_iter()))
+            .with_min_len(4096)
+            .for_each(|(v, (f, m))| *v += *f * (h / m));
+        b.omega
+            .par_iter_mut()
+            .zip(b.torque.par_iter().zip(b.inertia.par_iter()))
+            .with_min_len(4096)
+            .for_each(|(w, (t, i))| *w += t * h / i);
+    }
+
+    fn update_circles(&mut self, sys: &System) {
+        let b = &sys.bodies;
+        let nc = b.n_circles();
+        self.cpos.resize(nc, Vec2::ZERO);
+        self.carm.resize(nc, Vec2::ZERO);
+        self.cpos.par_iter_mut().zip(self.carm.par_iter_mut()).enumerate().with_min_len(4096).for_each(|(c, (x, a))| {
+            let k = b.circle_body[c] as usize;
+            let off = b.circle_offset[c];
+            *a = if off.x == 0.0 && off.y == 0.0 { Vec2::ZERO } else { off.rotated(b.angle[k]) };
+            *x = b.pos[k] + *a;
+        });
+    }
+
+    fn rebuild(&mut self, sys: &mut System, skin: f64) -> Result<(), DemError> {
+        let b = &sys.bodies;
+        let pairs = self.cells.build_pairs(&sys.domain, &self.cpos, &b.circle_r, &b.circle_body, skin)?;
+        let hist = carry_history(&sys.contacts.pairs, &sys.contacts.hist, &pairs);
+        sys.contacts.pairs = pairs;
+        sys.contacts.hist = hist;
+        let need = b.n_circles() * sys.walls.len();
+        if sys.contacts.wall_hist.len() != need {
+            sys.contacts.wall_hist.resize(need, History::default());
+        }
+        self.ref_pos.clone_from(&self.cpos);
+        // Per-circle index of pair entries, filled in pair order: canonical partner order.
+        let nc = b.n_circles();
+        self.csr_start.clear();
+        self.csr_start.resize(nc + 1, 0);
+        for pr in &sys.contacts.pairs {
+            self.csr_start[pr[0] as usize + 1] += 1;
+            self.csr_start[pr[1] as usize + 1] += 1;
+        }
+        for c in 0..nc {
+            self.csr_start[c + 1] += self.csr_start[c];
+        }
+        self.csr.clear();
+        self.csr.resize(self.csr_start[nc] as usize, 0);
+        let mut fill: Vec<u32> = self.csr_start[..nc].to_vec();
+        for (k, pr) in sys.contacts.pairs.iter().enumerate() {
+            for (side, &c) in pr.iter().enumerate() {
+                self.csr[fill[c as usize] as usize] = ((k as u32) << 1) | side as u32;
+                fill[c as usize] += 1;
+            }
+        }
+        self.out.resize(sys.contacts.pairs.len(), PairOut::default());
+        self.rebuilds += 1;
+        Ok(())
+    }
+
+    fn forces<L: ContactLaw>(&mut self, p: &StepParams, law: &L, wall_law: &L, sys: &mut System) {
+        let dt = p.dt;
+        let b = &sys.bodies;
+        let dom = sys.domain;
+        let (cpos, carm) = (&self.cpos, &self.carm);
+        // 1. Pair forces, one per pair, in parallel.
+        sys.contacts
+            .pairs
+            .par_iter()
+            .zip(sys.contacts.hist.par_iter_mut())
+            .zip(self.out.par_iter_mut())
+            .with_min_len(1024)
+            .for_each(|((pr, h), o)| {
+                let (i, j) = (pr[0] as usize, pr[1] as usize);
+                let d = dom.min_image(cpos[j] - cpos[i]);
+                let (ri, rj) = (b.circle_r[i], b.circle_r[j]);
+                let rs = ri + rj;
+                let d2 = d.norm2();
+                if d2 >= rs * rs {
+                    *h = History::default();
+                    *o = PairOut::default();
+                    return;
+                }
+                let dist = d2.sqrt();
+                let n = d * (1.0 / dist);
+                let delta = rs - dist;
+                let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
+                let (bi, bj) = (b.circle_body[i] as usize, b.circle_body[j] as usize);
+                let (wi, wj) = (b.omega[bi], b.omega[bj]);
+                let vi = b.vel[bi] + (carm[i] + n * ai).spin(wi);
+                let vj = b.vel[bj] + (carm[j] - n * aj).spin(wj);
+                let (mi, mj) = (b.mass[bi], b.mass[bj]);
+                let c = ContactInput {
+                    delta,
+                    n,
+                    v_rel: vi - vj,
+                    w_rel: wi - wj,
+                    r_eff: ri * rj / rs,
+                    m_eff: mi * mj / (mi + mj),
+                    dt,
+                };
+                let r = law.force(&c, h);
+                let nxf = n.cross(r.f);
+                *o = PairOut { f: r.f, ti: ai * nxf + r.m_roll, tj: aj * nxf - r.m_roll, touch: true };
+            });
+        // 2. Gather per body in canonical order.
+        let (out, csr, cs) = (&self.out, &self.csr, &self.csr_start);
+        let bodies = &mut sys.bodies;
+        let (cstart, force, torque) = (&bodies.circle_start, &mut bodies.force, &mut bodies.torque);
+        force.par_iter_mut().zip(torque.par_iter_mut()).enumerate().with_min_len(512).for_each(
+            |(k, (f, t))| {
+                let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
+                for c in cstart[k]..cstart[k + 1] {
+                    let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
+                    for &e in &csr[cs[c] as usize..cs[c + 1] as usize] {
+                        let o = &out[(e >> 1) as usize];
+                        if e & 1 == 0 {
+                            fc += o.f;
+                            tc += o.ti;
+                        } else {
+                            fc -= o.f;
+                            tc += o.tj;
+                        }
+                    }
+                    fb += fc;
+                    tb += tc + carm[c].cross(fc);
+                }
+                *f = fb;
+                *t = tb;
+            },
+        );
+        // 3. Walls: per circle in parallel, then a sequential sum in circle order.
+        let nw = sys.walls.len();
+        if nw > 0 {
+            let b = &sys.bodies;
+            let walls = &sys.walls;
+            self.wall_buf.resize(b.n_circles() * nw, (Vec2::ZERO, 0.0));
+            self.wall_buf
+                .par_chunks_mut(nw)
+                .zip(sys.contacts.wall_hist.par_chunks_mut(nw))
+                .enumerate()
+                .with_min_len(256)
+                .for_each(|(c, (buf, hist))| {
+                    let k = b.circle_body[c] as usize;
+                    let r = b.circle_r[c];
+                    for w in 0..nw {
+                        match walls[w].touch(cpos[c], r) {
+                            None => {
+                                hist[w] = History::default();
+                                buf[w] = (Vec2::ZERO, 0.0);
+                            }
+                            Some((delta, n)) => {
+                                let a = r - delta;
+                                let arm = carm[c] + n * a;
+                                let v = b.vel[k] + arm.spin(b.omega[k]);
+                                let ci = ContactInput {
+                                    delta,
+                                    n,
+                                    v_rel: v - walls[w].vel,
+                                    w_rel: b.omega[k],
+                                    r_eff: r,
+                                    m_eff: b.mass[k],
+                                    dt,
+                                };
+                                let o = wall_law.force(&ci, &mut hist[w]);
+                                buf[w] = (o.f, arm.cross(o.f) + o.m_roll);
+                            }
+                        }
+                    }
+                });
+            let mut wf = vec![Vec2::ZERO; nw];
+            let bodies = &mut sys.bodies;
+            for c in 0..bodies.n_circles() {
+                let k = bodies.circle_body[c] as usize;
+                for (w, wfw) in wf.iter_mut().enumerate() {
+                    let (f, t) = self.wall_buf[c * nw + w];
+                    bodies.force[k] += f;
+                    bodies.torque[k] += t;
+                    *wfw -= f;
+                }
+            }
+            for (w, f) in sys.walls.iter_mut().zip(wf) {
+                w.force = f;
+            }
+        }
+        // 4. Bonds, sequentially in bond order.
+        if let Some(bp) = sys.bond_params {
+            let bodies = &mut sys.bodies;
+            for bond in sys.bonds.iter_mut().filter(|b| !b.broken) {
+                let (i, j) = (bond.i as usize, bond.j as usize);
+                let d = dom.min_image(cpos[j] - cpos[i]);
+                let dist = d.norm();
+                let n = d * (1.0 / dist);
+                let (ri, rj) = (bodies.circle_r[i], bodies.circle_r[j]);
+                let (bi, bj) = (bodies.circle_body[i] as usize, bodies.circle_body[j] as usize);
+                // Contact point: midway through the gap/overlap.
+                let ai = ri + 0.5 * (dist - ri - rj);
+                let aj = dist - ai;
+                let vi = bodies.vel[bi] + (carm[i] + n * ai).spin(bodies.omega[bi]);
+                let vj = bodies.vel[bj] + (carm[j] - n * aj).spin(bodies.omega[bj]);
+                let c = ContactInput {
+                    delta: ri + rj - dist,
+                    n,
+                    v_rel: vi - vj,
+                    w_rel: bodies.omega[bi] - bodies.omega[bj],
+                    r_eff: ri * rj / (ri + rj),
+                    m_eff: 0.0,
+                    dt,
+                };
+                let (f, m) = bond.update(&bp, &c, ri, rj);
+                let nxf = n.cross(f);
+                bodies.force[bi] += f;
+                bodies.torque[bi] += ai * nxf + m + carm[i].cross(f);
+                bodies.force[bj] -= f;
+                bodies.torque[bj] += aj * nxf - m - carm[j].cross(f);
+            }
+        }
+        // 5. Body forces, drivers, damping.
+        let bodies = &mut sys.bodies;
+        if let Some(mem) = &sys.membrane {
+            for (k, &bk) in mem.bodies.iter().enumerate() {
+                let bk = bk as usize;
+                let f = mem.force_on(k, bodies.pos[bk]);
+                bodies.force[bk] += f;
+            }
+        }
+        let g = p.gravity * p.gravity_factor;
+        let (gv, al) = (p.viscous_damping, p.local_damping);
+        let Bodies5 { force, torque, vel, omega, mass, inertia, ext_force, ext_torque } = Bodies5::of(bodies);
+        force.par_iter_mut().zip(torque.par_iter_mut()).enumerate().with_min_len(1024).for_each(
+            |(k, (f, t))| {
+                *f += g * mass[k] + ext_force[k];
+                *t += ext_torque[k];
+                if gv > 0.0 {
+                    *f -= vel[k] * (gv * mass[k]);
+                    *t -= gv * inertia[k] * omega[k];
+                }
+                if al > 0.0 {
+                    f.x -= al * f.x.abs() * sign(vel[k].x);
+                    f.y -= al * f.y.abs() * sign(vel[k].y);
+                    *t -= al * t.abs() * sign(omega[k]);
+                }
+            },
+        );
+    }
+}
+
+#[inline]
+fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// Split borrows of the fields the last force pass needs.
+struct Bodies5<'a> {
+    force: &'a mut Vec<Vec2>,
+    torque: &'a mut Vec<f64>,
+    vel: &'a [Vec2],
+    omega: &'a [f64],
+    mass: &'a [f64],
+    inertia: &'a [f64],
+    ext_force: &'a [Vec2],
+    ext_torque: &'a [f64],
+}
+
+impl<'a> Bodies5<'a> {
+    fn of(b: &'a mut crate::body::Bodies) -> Self {
+        Self {
+            force: &mut b.force,
+            torque: &mut b.torque,
+            vel: &b.vel,
+            omega: &b.omega,
+            mass: &b.mass,
+            inertia: &b.inertia,
+            ext_force: &b.ext_force,
+            ext_torque: &b.ext_torque,
+        }
+    }
+}
