@@ -91,8 +91,8 @@ pub fn box_walls(lo: Vec2, hi: Vec2) -> Vec<Wall> {
 pub struct Compression {
     /// Target 2D stress (N/m) on every wall.
     pub target_stress: f64,
-    /// Wall speed per unit stress error (m/s per N/m).
-    pub gain: f64,
+    /// Servo relaxation factor α (fraction of the stress error closed per step; 0.1-0.5).
+    pub alpha: f64,
     pub v_max: f64,
     /// Stop when every wall is within this relative error of the target...
     pub tolerance: f64,
@@ -114,7 +114,7 @@ pub fn compress_isotropic<L: ContactLaw>(
     for k in 0..4 {
         let length = if k < 2 { ServoLength::Between(2, 3) } else { ServoLength::Between(0, 1) };
         sys.walls[k].motion =
-            WallMotion::Servo { target_stress: c.target_stress, gain: c.gain, v_max: c.v_max, length };
+            WallMotion::Servo { target_stress: c.target_stress, alpha: c.alpha, v_max: c.v_max, length };
     }
     let mut steps = 0;
     while steps < c.max_steps {

@@ -125,7 +125,7 @@ impl Stepper {
             b.pos.par_iter_mut().zip(b.vel.par_iter()).with_min_len(4096).for_each(|(x, v)| *x = dom.wrap(*x + *v * dt));
             b.angle.par_iter_mut().zip(b.omega.par_iter()).with_min_len(4096).for_each(|(a, w)| *a += w * dt);
         }
-        update_wall_velocities(&mut sys.walls);
+        update_wall_velocities(&mut sys.walls, wall_law.max_stiffness(1.0), dt);
         for w in sys.walls.iter_mut() {
             let v = w.vel;
             w.translate(v * dt);
@@ -330,6 +330,7 @@ impl Stepper {
                     }
                 });
             let mut wf = vec![Vec2::ZERO; nw];
+            let mut wn = vec![0u32; nw];
             let bodies = &mut sys.bodies;
             for c in 0..bodies.n_circles() {
                 let k = bodies.circle_body[c] as usize;
@@ -338,10 +339,12 @@ impl Stepper {
                     bodies.force[k] += f;
                     bodies.torque[k] += t;
                     *wfw -= f;
+                    wn[w] += u32::from(f != Vec2::ZERO);
                 }
             }
-            for (w, f) in sys.walls.iter_mut().zip(wf) {
+            for ((w, f), n) in sys.walls.iter_mut().zip(wf).zip(wn) {
                 w.force = f;
+                w.n_contacts = n;
             }
         }
         // 4. Bonds, sequentially in bond order.

@@ -28,8 +28,10 @@ pub enum ServoLength {
 pub enum WallMotion {
     Fixed,
     Velocity { v: Vec2 },
-    /// Wall speed along its normal = clamp(gain (σ_target − σ), ±v_max).
-    Servo { target_stress: f64, gain: f64, v_max: f64, length: ServoLength },
+    /// Servo (PFC-style, Itasca): the speed along the normal closes a fraction `alpha` of the
+    /// stress error per step, v = α L (σ_target − σ) / (k_n N_c Δt) with N_c the wall's contacts,
+    /// clamped to ±v_max (full speed while nothing touches the wall).
+    Servo { target_stress: f64, alpha: f64, v_max: f64, length: ServoLength },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -40,6 +42,9 @@ pub struct Wall {
     pub vel: Vec2,
     /// Force exerted by the particles on the wall at the last step.
     pub force: Vec2,
+    /// Number of circles touching the wall at the last step.
+    #[serde(default)]
+    pub n_contacts: u32,
 }
 
 impl Wall {
@@ -48,7 +53,7 @@ impl Wall {
             WallMotion::Velocity { v } => v,
             _ => Vec2::ZERO,
         };
-        Self { shape, motion, vel, force: Vec2::ZERO }
+        Self { shape, motion, vel, force: Vec2::ZERO, n_contacts: 0 }
     }
     pub fn plane(p: Vec2, n: Vec2) -> Self {
         Self::new(WallShape::Plane { p, n: n * (1.0 / n.norm()) }, WallMotion::Fixed)
@@ -100,16 +105,20 @@ impl Wall {
     }
 }
 
-/// Set each wall's velocity for the coming step from its motion (servo: from last force).
-pub fn update_wall_velocities(walls: &mut [Wall]) {
+/// Set each wall's velocity for the coming step from its motion (servo: from the last force;
+/// `k_n` is the contact stiffness, `dt` the step).
+pub fn update_wall_velocities(walls: &mut [Wall], k_n: f64, dt: f64) {
     for k in 0..walls.len() {
-        if let WallMotion::Servo { target_stress, gain, v_max, length } = walls[k].motion {
+        if let WallMotion::Servo { target_stress, alpha, v_max, length } = walls[k].motion {
             let l = match length {
                 ServoLength::Fixed(l) => l,
                 ServoLength::Between(a, b) => Wall::gap(&walls[a], &walls[b]),
             };
             let sigma = walls[k].stress(l.max(f64::MIN_POSITIVE));
-            let v = (gain * (target_stress - sigma)).clamp(-v_max, v_max);
+            let err = target_stress - sigma;
+            let nc = walls[k].n_contacts as f64;
+            let v = if nc > 0.0 { alpha * l * err / (k_n * nc * dt) } else { v_max.copysign(err) };
+            let v = v.clamp(-v_max, v_max);
             if let WallShape::Plane { n, .. } = walls[k].shape {
                 walls[k].vel = n * v;
             }
