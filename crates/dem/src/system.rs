@@ -85,3 +85,13 @@ impl System {
         self.bodies.total_area() / area
     }
 }
+
+impl System {
+    /// Serialise for a checkpoint (JSON with exact f64 round trip: serde_json `float_roundtrip`).
+    pub fn to_checkpoint(&self) -> Vec<u8> {
+        serde_json::to_vec(self).expect("a System always serialises")
+    }
+    pub fn from_checkpoint(bytes: &[u8]) -> Result<Self, serde_json::Error> {
+        serde_json::from_slice(bytes)
+    }
+}
