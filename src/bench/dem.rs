@@ -26,7 +26,7 @@ pub fn packing_10k(quick: bool) -> Result<System> {
     let (nc, nr) = if quick { (2000, 500) } else { (8000, 3000) };
     generate::compress_periodic(&mut s, &law, &p, 0.82, nc, &mut st)?;
     for _ in 0..nr {
-        st.step(&p, &law, &law, &mut s)?;
+        st.step_linear(&p, &law, &mut s)?;
     }
     Ok(s)
 }
@@ -50,12 +50,12 @@ fn timed(s0: &System, steps: usize, threads: usize) -> Result<(f64, f64)> {
         };
         for n in 0..200 {
             shear(&mut s, n);
-            st.step(&p, &law, &law, &mut s)?;
+            st.step_linear(&p, &law, &mut s)?;
         }
         let t0 = Instant::now();
         for n in 200..200 + steps as u64 {
             shear(&mut s, n);
-            st.step(&p, &law, &law, &mut s)?;
+            st.step_linear(&p, &law, &mut s)?;
         }
         let el = t0.elapsed().as_secs_f64();
         let z = 2.0 * st.n_contacts() as f64 / s.bodies.len() as f64;

@@ -26,12 +26,14 @@ impl Domain {
     /// Minimum-image separation vector on periodic axes.
     #[inline]
     pub fn min_image(&self, mut d: Vec2) -> Vec2 {
+        // Separations of candidate pairs never exceed one box length, so one conditional
+        // shift suffices (cheaper than a division and rounding per pair).
         let l = self.size();
-        if self.periodic[0] {
-            d.x -= l.x * (d.x / l.x).round();
+        if self.periodic[0] && d.x.abs() > 0.5 * l.x {
+            d.x -= l.x.copysign(d.x);
         }
-        if self.periodic[1] {
-            d.y -= l.y * (d.y / l.y).round();
+        if self.periodic[1] && d.y.abs() > 0.5 * l.y {
+            d.y -= l.y.copysign(d.y);
         }
         d
     }

@@ -6,7 +6,7 @@
 //! body gathers its pairs in canonical order; every other reduction runs in a fixed order, so
 //! results are bitwise identical for any number of threads.
 
-use crate::contact::{ContactInput, ContactLaw, History};
+use crate::contact::{ContactInput, ContactLaw, History, Law, LinearSpringDashpot};
 use crate::error::DemError;
 use crate::neighbor::{CellList, carry_history};
 use crate::system::System;
@@ -52,12 +52,24 @@ struct PairOut {
     touch: bool,
 }
 
+/// What the pair loop reads of a circle, packed in one cache line.
+#[derive(Clone, Copy, Debug, Default)]
+struct CircleState {
+    pos: Vec2,
+    /// Velocity of the circle centre.
+    vel: Vec2,
+    omega: f64,
+    r: f64,
+    mass: f64,
+}
+
 /// Scratch for stepping a [`System`].
 #[derive(Default)]
 pub struct Stepper {
     cells: CellList,
     cpos: Vec<Vec2>,
     carm: Vec<Vec2>,
+    cstate: Vec<CircleState>,
     ref_pos: Vec<Vec2>,
     out: Vec<PairOut>,
     /// Per circle: entries into `out` (pair index << 1 | 1 if the circle is j).
@@ -84,6 +96,24 @@ impl Stepper {
             k = k.max(p.k_n.max(p.k_s) * 2.0 * p.lambda * r_max);
         }
         (lbdem_core::units::dem::critical_time_step(m_min, k), m_min, k)
+    }
+
+    /// [`Stepper::step`] compiled in this crate for the scene-selectable [`Law`]: callers in
+    /// other crates get this crate's optimisation level instead of their own.
+    #[inline(never)]
+    pub fn step_law(&mut self, p: &StepParams, law: &Law, wall_law: &Law, sys: &mut System) -> Result<(), DemError> {
+        self.step(p, law, wall_law, sys)
+    }
+
+    /// [`Stepper::step`] for the linear law (benchmark case), compiled in this crate.
+    #[inline(never)]
+    pub fn step_linear(
+        &mut self,
+        p: &StepParams,
+        law: &LinearSpringDashpot,
+        sys: &mut System,
+    ) -> Result<(), DemError> {
+        self.step(p, law, law, sys)
     }
 
     /// Number of pairs in contact at the last force evaluation.
@@ -223,7 +253,18 @@ impl Stepper {
         let dt = p.dt;
         let b = &sys.bodies;
         let dom = sys.domain;
-        let (cpos, carm) = (&self.cpos, &self.carm);
+        self.cstate.resize(b.n_circles(), CircleState::default());
+        self.cstate.par_iter_mut().enumerate().with_min_len(4096).for_each(|(c, s)| {
+            let k = b.circle_body[c] as usize;
+            *s = CircleState {
+                pos: self.cpos[c],
+                vel: b.vel[k] + self.carm[c].spin(b.omega[k]),
+                omega: b.omega[k],
+                r: b.circle_r[c],
+                mass: b.mass[k],
+            };
+        });
+        let (cpos, carm, cst) = (&self.cpos, &self.carm, &self.cstate);
         // 1. Pair forces, one per pair, in parallel.
         sys.contacts
             .pairs
@@ -232,9 +273,9 @@ impl Stepper {
             .zip(self.out.par_iter_mut())
             .with_min_len(1024)
             .for_each(|((pr, h), o)| {
-                let (i, j) = (pr[0] as usize, pr[1] as usize);
-                let d = dom.min_image(cpos[j] - cpos[i]);
-                let (ri, rj) = (b.circle_r[i], b.circle_r[j]);
+                let (ci, cj) = (&cst[pr[0] as usize], &cst[pr[1] as usize]);
+                let d = dom.min_image(cj.pos - ci.pos);
+                let (ri, rj) = (ci.r, cj.r);
                 let rs = ri + rj;
                 let d2 = d.norm2();
                 if d2 >= rs * rs {
@@ -246,11 +287,10 @@ impl Stepper {
                 let n = d * (1.0 / dist);
                 let delta = rs - dist;
                 let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
-                let (bi, bj) = (b.circle_body[i] as usize, b.circle_body[j] as usize);
-                let (wi, wj) = (b.omega[bi], b.omega[bj]);
-                let vi = b.vel[bi] + (carm[i] + n * ai).spin(wi);
-                let vj = b.vel[bj] + (carm[j] - n * aj).spin(wj);
-                let (mi, mj) = (b.mass[bi], b.mass[bj]);
+                let (wi, wj) = (ci.omega, cj.omega);
+                let vi = ci.vel + (n * ai).spin(wi);
+                let vj = cj.vel - (n * aj).spin(wj);
+                let (mi, mj) = (ci.mass, cj.mass);
                 let c = ContactInput {
                     delta,
                     n,

@@ -85,7 +85,7 @@ pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
         wall_forces: sys.walls.iter().map(|w| [w.force.x, w.force.y]).collect(),
     };
     while sys.step < r.steps {
-        st.step(&p, &law, &wall_law, &mut sys).map_err(|e| {
+        st.step_law(&p, &law, &wall_law, &mut sys).map_err(|e| {
             anyhow::anyhow!("dry scene: {e} (set [step] dt in the scene file)")
         })?;
         let n = sys.step;
