@@ -73,10 +73,17 @@ fn peer(n_side: usize, np: usize, steps: usize) -> Result<f64> {
         .with_context(|| format!("cannot run {}", script.display()))?;
     let text = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
-        bail!("{} failed: {}", script.display(), String::from_utf8_lossy(&out.stderr));
+        bail!(
+            "{} failed: {}",
+            script.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     // "Loop time of T on P procs for S steps with N atoms"
-    let line = text.lines().rfind(|l| l.starts_with("Loop time")).context("no 'Loop time' line from LAMMPS")?;
+    let line = text
+        .lines()
+        .rfind(|l| l.starts_with("Loop time"))
+        .context("no 'Loop time' line from LAMMPS")?;
     let w: Vec<&str> = line.split_whitespace().collect();
     let t: f64 = w[3].parse()?;
     let s: f64 = w[8].parse()?;
@@ -94,7 +101,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         cases.push(("100k", 316, generate::tile(&s10, 5, 2)?, 400));
     }
     let mut rows = Vec::new();
-    println!("| case | N | threads | lbdem M p-steps/s (median of {reps}) | z | LAMMPS M p-steps/s | ratio |");
+    println!(
+        "| case | N | threads | lbdem M p-steps/s (median of {reps}) | z | LAMMPS M p-steps/s | ratio |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for (name, n_side, s, steps) in &cases {
         for threads in [1usize, 2] {

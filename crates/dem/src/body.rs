@@ -35,7 +35,10 @@ pub struct Bodies {
 
 impl Bodies {
     pub fn new() -> Self {
-        Self { circle_start: vec![0], ..Default::default() }
+        Self {
+            circle_start: vec![0],
+            ..Default::default()
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -50,9 +53,19 @@ impl Bodies {
 
     /// Add a rigid clump with density `rho` (kg/m², unit thickness). `shape` may be in any frame:
     /// its centroid is placed at `at` and it is rotated by `angle`. Returns the body index.
-    pub fn add(&mut self, shape: &ClumpShape<Vec2>, rho: f64, at: Vec2, angle: f64) -> Result<usize, DemError> {
+    pub fn add(
+        &mut self,
+        shape: &ClumpShape<Vec2>,
+        rho: f64,
+        at: Vec2,
+        angle: f64,
+    ) -> Result<usize, DemError> {
         if !(rho > 0.0 && rho.is_finite()) {
-            return Err(DemError::BadParameter { name: "density", value: rho, why: "must be positive" });
+            return Err(DemError::BadParameter {
+                name: "density",
+                value: rho,
+                why: "must be positive",
+            });
         }
         let (c, mp) = shape.centred()?;
         let b = self.pos.len();
@@ -81,7 +94,12 @@ impl Bodies {
     pub fn shape(&self, b: usize) -> ClumpShape<Vec2> {
         let r = self.circle_start[b]..self.circle_start[b + 1];
         ClumpShape {
-            balls: r.map(|c| crate::shape::Ball { centre: self.circle_offset[c], r: self.circle_r[c] }).collect(),
+            balls: r
+                .map(|c| crate::shape::Ball {
+                    centre: self.circle_offset[c],
+                    r: self.circle_r[c],
+                })
+                .collect(),
         }
     }
 
@@ -154,4 +172,3 @@ impl Bodies {
         self.vel.iter().map(|v| v.norm2().sqrt()).fold(0.0, f64::max)
     }
 }
-

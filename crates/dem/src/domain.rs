@@ -14,10 +14,18 @@ pub struct Domain {
 
 impl Domain {
     pub fn open(lo: Vec2, hi: Vec2) -> Self {
-        Self { lo, hi, periodic: [false, false] }
+        Self {
+            lo,
+            hi,
+            periodic: [false, false],
+        }
     }
     pub fn periodic(lo: Vec2, hi: Vec2) -> Self {
-        Self { lo, hi, periodic: [true, true] }
+        Self {
+            lo,
+            hi,
+            periodic: [true, true],
+        }
     }
     #[inline]
     pub fn size(&self) -> Vec2 {

@@ -56,8 +56,14 @@ pub fn random_insert(
                 lo.y + br + (hi.y - lo.y - 2.0 * br) * r.random::<f64>(),
             );
             let ang = std::f64::consts::TAU * r.random::<f64>();
-            let mine: Vec<(Vec2, f64)> = shape.balls.iter().map(|b| (at + b.centre.rotated(ang), b.r)).collect();
-            let clash = mine.iter().any(|&(p, rr)| circles.iter().any(|&(q, rq)| (p - q).norm2() < (rr + rq).powi(2)));
+            let mine: Vec<(Vec2, f64)> = shape
+                .balls
+                .iter()
+                .map(|b| (at + b.centre.rotated(ang), b.r))
+                .collect();
+            let clash = mine
+                .iter()
+                .any(|&(p, rr)| circles.iter().any(|&(q, rq)| (p - q).norm2() < (rr + rq).powi(2)));
             if !clash {
                 circles.extend(mine);
                 bodies.add(&shape, density, at, ang)?;
@@ -112,9 +118,17 @@ pub fn compress_isotropic<L: ContactLaw>(
     stepper: &mut Stepper,
 ) -> Result<u64, DemError> {
     for k in 0..4 {
-        let length = if k < 2 { ServoLength::Between(2, 3) } else { ServoLength::Between(0, 1) };
-        sys.walls[k].motion =
-            WallMotion::Servo { target_stress: c.target_stress, alpha: c.alpha, v_max: c.v_max, length };
+        let length = if k < 2 {
+            ServoLength::Between(2, 3)
+        } else {
+            ServoLength::Between(0, 1)
+        };
+        sys.walls[k].motion = WallMotion::Servo {
+            target_stress: c.target_stress,
+            alpha: c.alpha,
+            v_max: c.v_max,
+            length,
+        };
     }
     let mut steps = 0;
     while steps < c.max_steps {
@@ -122,7 +136,11 @@ pub fn compress_isotropic<L: ContactLaw>(
         steps += 1;
         if steps % 100 == 0 {
             let ok = (0..4).all(|k| {
-                let l = if k < 2 { Wall::gap(&sys.walls[2], &sys.walls[3]) } else { Wall::gap(&sys.walls[0], &sys.walls[1]) };
+                let l = if k < 2 {
+                    Wall::gap(&sys.walls[2], &sys.walls[3])
+                } else {
+                    Wall::gap(&sys.walls[0], &sys.walls[1])
+                };
                 (sys.walls[k].stress(l) / c.target_stress - 1.0).abs() < c.tolerance
             });
             if ok && sys.bodies.max_speed() < c.v_threshold {
@@ -162,7 +180,13 @@ pub fn remove_random(sys: &mut System, n: usize, seed: u64) {
 
 /// Add up to `n` copies of `shape` into interstices (random trials without overlap inside the
 /// box of walls 0-3); returns how many were added (raises the packing fraction).
-pub fn add_in_voids(sys: &mut System, shape: &ClumpShape<Vec2>, density: f64, n: usize, seed: u64) -> Result<usize, DemError> {
+pub fn add_in_voids(
+    sys: &mut System,
+    shape: &ClumpShape<Vec2>,
+    density: f64,
+    n: usize,
+    seed: u64,
+) -> Result<usize, DemError> {
     let mut r = rng(seed);
     let (lo, hi) = wall_box(sys);
     let (shape, _) = shape.centred()?;
@@ -170,7 +194,10 @@ pub fn add_in_voids(sys: &mut System, shape: &ClumpShape<Vec2>, density: f64, n:
     let mut trials = 0;
     while added < n && trials < 200_000 {
         trials += 1;
-        let at = Vec2::new(lo.x + (hi.x - lo.x) * r.random::<f64>(), lo.y + (hi.y - lo.y) * r.random::<f64>());
+        let at = Vec2::new(
+            lo.x + (hi.x - lo.x) * r.random::<f64>(),
+            lo.y + (hi.y - lo.y) * r.random::<f64>(),
+        );
         let ang = std::f64::consts::TAU * r.random::<f64>();
         let br = shape.bounding_radius();
         if at.x - br < lo.x || at.x + br > hi.x || at.y - br < lo.y || at.y + br > hi.y {
@@ -195,7 +222,10 @@ fn wall_box(sys: &System) -> (Vec2, Vec2) {
         WallShape::Plane { p, .. } => p,
         WallShape::Segment { a, .. } => a,
     };
-    (Vec2::new(x(&sys.walls[0]).x, x(&sys.walls[2]).y), Vec2::new(x(&sys.walls[1]).x, x(&sys.walls[3]).y))
+    (
+        Vec2::new(x(&sys.walls[0]).x, x(&sys.walls[2]).y),
+        Vec2::new(x(&sys.walls[1]).x, x(&sys.walls[3]).y),
+    )
 }
 
 /// Step until every grain is slower than `v_threshold` (checked every 100 steps) or `max_steps`.
@@ -230,7 +260,12 @@ pub fn bidisperse_lattice(n_side: usize, d: f64, ratio: f64, a: f64, seed: u64) 
     for iy in 0..n_side {
         for ix in 0..n_side {
             let s = if r.random::<f64>() < 0.5 { &small } else { &large };
-            let k = bodies.add(s, 1.0, Vec2::new((ix as f64 + 0.5) * a, (iy as f64 + 0.5) * a), 0.0)?;
+            let k = bodies.add(
+                s,
+                1.0,
+                Vec2::new((ix as f64 + 0.5) * a, (iy as f64 + 0.5) * a),
+                0.0,
+            )?;
             bodies.vel[k] = Vec2::new(r.random::<f64>() - 0.5, r.random::<f64>() - 0.5) * 2e-4;
         }
     }
@@ -271,7 +306,12 @@ pub fn tile(sys: &System, nx: usize, ny: usize) -> Result<System, DemError> {
         for tx in 0..nx {
             let shift = Vec2::new(tx as f64 * s.x, ty as f64 * s.y);
             for k in 0..sys.bodies.len() {
-                let nk = b.add(&sys.bodies.shape(k), sys.bodies.density[k], sys.bodies.pos[k] + shift, sys.bodies.angle[k])?;
+                let nk = b.add(
+                    &sys.bodies.shape(k),
+                    sys.bodies.density[k],
+                    sys.bodies.pos[k] + shift,
+                    sys.bodies.angle[k],
+                )?;
                 b.vel[nk] = sys.bodies.vel[k];
                 b.omega[nk] = sys.bodies.omega[k];
             }
@@ -279,5 +319,12 @@ pub fn tile(sys: &System, nx: usize, ny: usize) -> Result<System, DemError> {
     }
     let lo = sys.domain.lo;
     let hi = lo + Vec2::new(s.x * nx as f64, s.y * ny as f64);
-    Ok(System::new(b, Domain { lo, hi, periodic: sys.domain.periodic }))
+    Ok(System::new(
+        b,
+        Domain {
+            lo,
+            hi,
+            periodic: sys.domain.periodic,
+        },
+    ))
 }

@@ -49,7 +49,9 @@ impl CellList {
         let nx = ((size.x / cut).floor() as usize).max(1);
         let ny = ((size.y / cut).floor() as usize).max(1);
         if nx.saturating_mul(ny) > MAX_CELLS {
-            return Err(DemError::TooManyCells { cells: nx.saturating_mul(ny) });
+            return Err(DemError::TooManyCells {
+                cells: nx.saturating_mul(ny),
+            });
         }
         self.ncell = [nx, ny];
         let (cx, cy) = (size.x / nx as f64, size.y / ny as f64);

@@ -34,7 +34,12 @@ pub struct MassProps2 {
 
 impl ClumpShape<Vec2> {
     pub fn disk(r: f64) -> Self {
-        Self { balls: vec![Ball { centre: Vec2::ZERO, r }] }
+        Self {
+            balls: vec![Ball {
+                centre: Vec2::ZERO,
+                r,
+            }],
+        }
     }
 
     /// Mass properties of the union of the circles: the overlap is counted once.
@@ -56,7 +61,11 @@ impl ClumpShape<Vec2> {
         if self.balls.len() == 1 {
             let b = self.balls[0];
             let a = std::f64::consts::PI * b.r * b.r;
-            return Ok(MassProps2 { area: a, centroid: b.centre, polar_moment: 0.5 * a * b.r * b.r });
+            return Ok(MassProps2 {
+                area: a,
+                centroid: b.centre,
+                polar_moment: 0.5 * a * b.r * b.r,
+            });
         }
         // Breakpoints: every circle's left/right end and every pairwise intersection abscissa.
         let mut xs: Vec<f64> = Vec::new();
@@ -123,7 +132,11 @@ impl ClumpShape<Vec2> {
         }
         let c = Vec2::new(mx / m0, my / m0);
         let polar = mxx + myy - m0 * (c.x * c.x + c.y * c.y);
-        Ok(MassProps2 { area: m0, centroid: c, polar_moment: polar })
+        Ok(MassProps2 {
+            area: m0,
+            centroid: c,
+            polar_moment: polar,
+        })
     }
 
     /// The same shape with its centroid moved to the origin (body frame).
@@ -132,19 +145,40 @@ impl ClumpShape<Vec2> {
         let balls = self
             .balls
             .iter()
-            .map(|b| Ball { centre: b.centre - mp.centroid, r: b.r })
+            .map(|b| Ball {
+                centre: b.centre - mp.centroid,
+                r: b.r,
+            })
             .collect();
-        Ok((Self { balls }, MassProps2 { centroid: Vec2::ZERO, ..mp }))
+        Ok((
+            Self { balls },
+            MassProps2 {
+                centroid: Vec2::ZERO,
+                ..mp
+            },
+        ))
     }
 
     /// Radius of the smallest circle about the origin enclosing the clump.
     pub fn bounding_radius(&self) -> f64 {
-        self.balls.iter().map(|b| b.centre.norm() + b.r).fold(0.0, f64::max)
+        self.balls
+            .iter()
+            .map(|b| b.centre.norm() + b.r)
+            .fold(0.0, f64::max)
     }
 
     /// Scaled copy (positions and radii by `s`).
     pub fn scaled(&self, s: f64) -> Self {
-        Self { balls: self.balls.iter().map(|b| Ball { centre: b.centre * s, r: b.r * s }).collect() }
+        Self {
+            balls: self
+                .balls
+                .iter()
+                .map(|b| Ball {
+                    centre: b.centre * s,
+                    r: b.r * s,
+                })
+                .collect(),
+        }
     }
 }
 

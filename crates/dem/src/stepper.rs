@@ -40,7 +40,14 @@ fn one() -> f64 {
 
 impl StepParams {
     pub fn new(dt: f64, skin: f64) -> Self {
-        Self { dt, gravity: Vec2::ZERO, gravity_factor: 1.0, viscous_damping: 0.0, local_damping: 0.0, skin }
+        Self {
+            dt,
+            gravity: Vec2::ZERO,
+            gravity_factor: 1.0,
+            viscous_damping: 0.0,
+            local_damping: 0.0,
+            skin,
+        }
     }
 }
 
@@ -101,7 +108,13 @@ impl Stepper {
     /// [`Stepper::step`] compiled in this crate for the scene-selectable [`Law`]: callers in
     /// other crates get this crate's optimisation level instead of their own.
     #[inline(never)]
-    pub fn step_law(&mut self, p: &StepParams, law: &Law, wall_law: &Law, sys: &mut System) -> Result<(), DemError> {
+    pub fn step_law(
+        &mut self,
+        p: &StepParams,
+        law: &Law,
+        wall_law: &Law,
+        sys: &mut System,
+    ) -> Result<(), DemError> {
         self.step(p, law, wall_law, sys)
     }
 
@@ -132,8 +145,13 @@ impl Stepper {
         let dt = p.dt;
         if self.checked_dt != dt || self.n_circles != sys.bodies.n_circles() {
             let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
-            if !(dt > 0.0) || dt > crit {
-                return Err(DemError::TimeStepTooLarge { dt, critical: crit, m_min, k_max });
+            if dt.is_nan() || dt <= 0.0 || dt > crit {
+                return Err(DemError::TimeStepTooLarge {
+                    dt,
+                    critical: crit,
+                    m_min,
+                    k_max,
+                });
             }
             self.checked_dt = dt;
             let fresh = self.n_circles != sys.bodies.n_circles() || self.ref_pos.is_empty();
@@ -152,8 +170,16 @@ impl Stepper {
         {
             let b = &mut sys.bodies;
             let dom = sys.domain;
-            b.pos.par_iter_mut().zip(b.vel.par_iter()).with_min_len(4096).for_each(|(x, v)| *x = dom.wrap(*x + *v * dt));
-            b.angle.par_iter_mut().zip(b.omega.par_iter()).with_min_len(4096).for_each(|(a, w)| *a += w * dt);
+            b.pos
+                .par_iter_mut()
+                .zip(b.vel.par_iter())
+                .with_min_len(4096)
+                .for_each(|(x, v)| *x = dom.wrap(*x + *v * dt));
+            b.angle
+                .par_iter_mut()
+                .zip(b.omega.par_iter())
+                .with_min_len(4096)
+                .for_each(|(a, w)| *a += w * dt);
         }
         update_wall_velocities(&mut sys.walls, wall_law.max_stiffness(1.0), dt);
         for w in sys.walls.iter_mut() {
@@ -169,7 +195,16 @@ impl Stepper {
             .zip(self.ref_pos.par_iter())
             .with_min_len(4096)
             .map(|(a, b)| dom.min_image(*a - *b).norm2())
-            .reduce(|| 0.0, |a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) });
+            .reduce(
+                || 0.0,
+                |a, b| {
+                    if a.is_nan() || b.is_nan() {
+                        f64::NAN
+                    } else {
+                        a.max(b)
+                    }
+                },
+            );
         if !worst.is_finite() {
             let body = (0..sys.bodies.len())
                 .find(|&k| !(sys.bodies.pos[k].norm2().is_finite() && sys.bodies.vel[k].norm2().is_finite()))
@@ -205,17 +240,28 @@ impl Stepper {
         let nc = b.n_circles();
         self.cpos.resize(nc, Vec2::ZERO);
         self.carm.resize(nc, Vec2::ZERO);
-        self.cpos.par_iter_mut().zip(self.carm.par_iter_mut()).enumerate().with_min_len(4096).for_each(|(c, (x, a))| {
-            let k = b.circle_body[c] as usize;
-            let off = b.circle_offset[c];
-            *a = if off.x == 0.0 && off.y == 0.0 { Vec2::ZERO } else { off.rotated(b.angle[k]) };
-            *x = b.pos[k] + *a;
-        });
+        self.cpos
+            .par_iter_mut()
+            .zip(self.carm.par_iter_mut())
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(c, (x, a))| {
+                let k = b.circle_body[c] as usize;
+                let off = b.circle_offset[c];
+                *a = if off.x == 0.0 && off.y == 0.0 {
+                    Vec2::ZERO
+                } else {
+                    off.rotated(b.angle[k])
+                };
+                *x = b.pos[k] + *a;
+            });
     }
 
     fn rebuild(&mut self, sys: &mut System, skin: f64) -> Result<(), DemError> {
         let b = &sys.bodies;
-        let pairs = self.cells.build_pairs(&sys.domain, &self.cpos, &b.circle_r, &b.circle_body, skin)?;
+        let pairs = self
+            .cells
+            .build_pairs(&sys.domain, &self.cpos, &b.circle_r, &b.circle_body, skin)?;
         let hist = carry_history(&sys.contacts.pairs, &sys.contacts.hist, &pairs);
         sys.contacts.pairs = pairs;
         sys.contacts.hist = hist;
@@ -254,16 +300,20 @@ impl Stepper {
         let b = &sys.bodies;
         let dom = sys.domain;
         self.cstate.resize(b.n_circles(), CircleState::default());
-        self.cstate.par_iter_mut().enumerate().with_min_len(4096).for_each(|(c, s)| {
-            let k = b.circle_body[c] as usize;
-            *s = CircleState {
-                pos: self.cpos[c],
-                vel: b.vel[k] + self.carm[c].spin(b.omega[k]),
-                omega: b.omega[k],
-                r: b.circle_r[c],
-                mass: b.mass[k],
-            };
-        });
+        self.cstate
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(c, s)| {
+                let k = b.circle_body[c] as usize;
+                *s = CircleState {
+                    pos: self.cpos[c],
+                    vel: b.vel[k] + self.carm[c].spin(b.omega[k]),
+                    omega: b.omega[k],
+                    r: b.circle_r[c],
+                    mass: b.mass[k],
+                };
+            });
         let (cpos, carm, cst) = (&self.cpos, &self.carm, &self.cstate);
         // 1. Pair forces, one per pair, in parallel.
         sys.contacts
@@ -302,14 +352,23 @@ impl Stepper {
                 };
                 let r = law.force(&c, h);
                 let nxf = n.cross(r.f);
-                *o = PairOut { f: r.f, ti: ai * nxf + r.m_roll, tj: aj * nxf - r.m_roll, touch: true };
+                *o = PairOut {
+                    f: r.f,
+                    ti: ai * nxf + r.m_roll,
+                    tj: aj * nxf - r.m_roll,
+                    touch: true,
+                };
             });
         // 2. Gather per body in canonical order.
         let (out, csr, cs) = (&self.out, &self.csr, &self.csr_start);
         let bodies = &mut sys.bodies;
         let (cstart, force, torque) = (&bodies.circle_start, &mut bodies.force, &mut bodies.torque);
-        force.par_iter_mut().zip(torque.par_iter_mut()).enumerate().with_min_len(512).for_each(
-            |(k, (f, t))| {
+        force
+            .par_iter_mut()
+            .zip(torque.par_iter_mut())
+            .enumerate()
+            .with_min_len(512)
+            .for_each(|(k, (f, t))| {
                 let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
                 for c in cstart[k]..cstart[k + 1] {
                     let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
@@ -328,8 +387,7 @@ impl Stepper {
                 }
                 *f = fb;
                 *t = tb;
-            },
-        );
+            });
         // 3. Walls: per circle in parallel, then a sequential sum in circle order.
         let nw = sys.walls.len();
         if nw > 0 {
@@ -430,9 +488,22 @@ impl Stepper {
         }
         let g = p.gravity * p.gravity_factor;
         let (gv, al) = (p.viscous_damping, p.local_damping);
-        let Bodies5 { force, torque, vel, omega, mass, inertia, ext_force, ext_torque } = Bodies5::of(bodies);
-        force.par_iter_mut().zip(torque.par_iter_mut()).enumerate().with_min_len(1024).for_each(
-            |(k, (f, t))| {
+        let Bodies5 {
+            force,
+            torque,
+            vel,
+            omega,
+            mass,
+            inertia,
+            ext_force,
+            ext_torque,
+        } = Bodies5::of(bodies);
+        force
+            .par_iter_mut()
+            .zip(torque.par_iter_mut())
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(k, (f, t))| {
                 *f += g * mass[k] + ext_force[k];
                 *t += ext_torque[k];
                 if gv > 0.0 {
@@ -444,8 +515,7 @@ impl Stepper {
                     f.y -= al * f.y.abs() * sign(vel[k].y);
                     *t -= al * t.abs() * sign(omega[k]);
                 }
-            },
-        );
+            });
     }
 }
 

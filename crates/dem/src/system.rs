@@ -29,7 +29,13 @@ impl Membrane {
             centre += *p;
         }
         centre = centre * (1.0 / reference.len().max(1) as f64);
-        Self { bodies, reference, centre, threshold, force }
+        Self {
+            bodies,
+            reference,
+            centre,
+            threshold,
+            force,
+        }
     }
 
     /// Driver force on member `k` at position `p`.
@@ -41,7 +47,11 @@ impl Membrane {
             return Vec2::ZERO;
         }
         let e = out * (1.0 / l);
-        if (p - self.reference[k]).dot(e) > self.threshold { e * (-self.force) } else { Vec2::ZERO }
+        if (p - self.reference[k]).dot(e) > self.threshold {
+            e * (-self.force)
+        } else {
+            Vec2::ZERO
+        }
     }
 }
 

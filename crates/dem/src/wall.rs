@@ -27,11 +27,18 @@ pub enum ServoLength {
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum WallMotion {
     Fixed,
-    Velocity { v: Vec2 },
+    Velocity {
+        v: Vec2,
+    },
     /// Servo (PFC-style, Itasca): the speed along the normal closes a fraction `alpha` of the
     /// stress error per step, v = α L (σ_target − σ) / (k_n N_c Δt) with N_c the wall's contacts,
     /// clamped to ±v_max (full speed while nothing touches the wall).
-    Servo { target_stress: f64, alpha: f64, v_max: f64, length: ServoLength },
+    Servo {
+        target_stress: f64,
+        alpha: f64,
+        v_max: f64,
+        length: ServoLength,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -53,10 +60,22 @@ impl Wall {
             WallMotion::Velocity { v } => v,
             _ => Vec2::ZERO,
         };
-        Self { shape, motion, vel, force: Vec2::ZERO, n_contacts: 0 }
+        Self {
+            shape,
+            motion,
+            vel,
+            force: Vec2::ZERO,
+            n_contacts: 0,
+        }
     }
     pub fn plane(p: Vec2, n: Vec2) -> Self {
-        Self::new(WallShape::Plane { p, n: n * (1.0 / n.norm()) }, WallMotion::Fixed)
+        Self::new(
+            WallShape::Plane {
+                p,
+                n: n * (1.0 / n.norm()),
+            },
+            WallMotion::Fixed,
+        )
     }
 
     /// Overlap and unit normal from the circle towards the wall, if touching.
@@ -109,7 +128,13 @@ impl Wall {
 /// `k_n` is the contact stiffness, `dt` the step).
 pub fn update_wall_velocities(walls: &mut [Wall], k_n: f64, dt: f64) {
     for k in 0..walls.len() {
-        if let WallMotion::Servo { target_stress, alpha, v_max, length } = walls[k].motion {
+        if let WallMotion::Servo {
+            target_stress,
+            alpha,
+            v_max,
+            length,
+        } = walls[k].motion
+        {
             let l = match length {
                 ServoLength::Fixed(l) => l,
                 ServoLength::Between(a, b) => Wall::gap(&walls[a], &walls[b]),
@@ -117,7 +142,11 @@ pub fn update_wall_velocities(walls: &mut [Wall], k_n: f64, dt: f64) {
             let sigma = walls[k].stress(l.max(f64::MIN_POSITIVE));
             let err = target_stress - sigma;
             let nc = walls[k].n_contacts as f64;
-            let v = if nc > 0.0 { alpha * l * err / (k_n * nc * dt) } else { v_max.copysign(err) };
+            let v = if nc > 0.0 {
+                alpha * l * err / (k_n * nc * dt)
+            } else {
+                v_max.copysign(err)
+            };
             let v = v.clamp(-v_max, v_max);
             if let WallShape::Plane { n, .. } = walls[k].shape {
                 walls[k].vel = n * v;

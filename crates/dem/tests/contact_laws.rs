@@ -2,8 +2,8 @@
 
 mod common;
 use common::two;
-use lbdem_dem::contact::{Bond, BondParams, ContactInput, ElasticPlastic, HertzMindlin, LinearSpringDashpot};
 use lbdem_dem::contact::plastic::su_yield_force;
+use lbdem_dem::contact::{Bond, BondParams, ContactInput, ElasticPlastic, HertzMindlin, LinearSpringDashpot};
 use lbdem_dem::*;
 
 /// Run a head-on collision of two disks (radius 0.5, density 1) at relative speed `v`;
@@ -46,8 +46,14 @@ fn linear_restitution_and_duration_over_damping_ratios() {
         let e_exact = (-std::f64::consts::PI * zeta / (1.0 - zeta * zeta).sqrt()).exp();
         // Velocity Verlet evaluates the dashpot with the half-step velocity: first order in
         // ω dt (here 8e-4), so the tolerance is a few ω dt.
-        assert!((e - e_exact).abs() / e_exact < 5e-3, "zeta {zeta}: e = {e}, analytic {e_exact}");
-        assert!((dur - tc).abs() / tc < 2e-3, "zeta {zeta}: t_c = {dur}, analytic {tc}");
+        assert!(
+            (e - e_exact).abs() / e_exact < 5e-3,
+            "zeta {zeta}: e = {e}, analytic {e_exact}"
+        );
+        assert!(
+            (dur - tc).abs() / tc < 2e-3,
+            "zeta {zeta}: t_c = {dur}, analytic {tc}"
+        );
     }
 }
 
@@ -55,7 +61,14 @@ fn linear_restitution_and_duration_over_damping_ratios() {
 /// t_c = 2.943275 δ_max / v. Leonardi et al. 2014 Eq. 5 with A = 0 has E* = Y/(2(1−ν²)).
 #[test]
 fn hertz_contact_duration() {
-    let law = HertzMindlin { young: 1.0e6, poisson: 0.3, a_damp: 0.0, eta: 0.0, mu: 0.0, max_overlap: 0.05 };
+    let law = HertzMindlin {
+        young: 1.0e6,
+        poisson: 0.3,
+        a_damp: 0.0,
+        eta: 0.0,
+        mu: 0.0,
+        max_overlap: 0.05,
+    };
     let v = 0.05;
     let m_eff = 0.5 * std::f64::consts::PI * 0.25;
     let e_star = law.young / (2.0 * (1.0 - law.poisson * law.poisson));
@@ -73,7 +86,10 @@ fn hertz_contact_duration() {
 fn su_eq6_matches_table1() {
     for (rate, df) in [(1e-6, 6.6e-10), (30e-6, 1.6e-9), (2150e-6, 4.9e-9)] {
         let got = su_yield_force(0.0, rate);
-        assert!((got - df).abs() / df < 0.02, "rate {rate}: F_y - F_0 = {got}, Table 1 {df}");
+        assert!(
+            (got - df).abs() / df < 0.02,
+            "rate {rate}: F_y - F_0 = {got}, Table 1 {df}"
+        );
     }
 }
 
@@ -99,15 +115,29 @@ fn elastic_plastic_loading_unloading_loop() {
     let (mut work, mut prev_d, mut prev_f) = (0.0, 0.0, 0.0);
     let mut fmax = 0.0;
     for k in 0..=2 * n {
-        let d = if k <= n { dmax * k as f64 / n as f64 } else { dmax * (2 * n - k) as f64 / n as f64 };
+        let d = if k <= n {
+            dmax * k as f64 / n as f64
+        } else {
+            dmax * (2 * n - k) as f64 / n as f64
+        };
         let f = law.normal(d, &mut h);
         if k <= n {
-            let expect = if d <= uy { law.k_e * d } else { law.f_y + law.k_p * (d - uy) };
-            assert!((f - expect).abs() <= 1e-12 * law.f_y, "loading at {d}: {f} vs {expect}");
+            let expect = if d <= uy {
+                law.k_e * d
+            } else {
+                law.f_y + law.k_p * (d - uy)
+            };
+            assert!(
+                (f - expect).abs() <= 1e-12 * law.f_y,
+                "loading at {d}: {f} vs {expect}"
+            );
             fmax = f;
         } else {
             let expect = (fmax - law.k_e * (dmax - d)).max(0.0);
-            assert!((f - expect).abs() <= 1e-9 * law.f_y, "unloading at {d}: {f} vs {expect}");
+            assert!(
+                (f - expect).abs() <= 1e-9 * law.f_y,
+                "unloading at {d}: {f} vs {expect}"
+            );
         }
         work += 0.5 * (f + prev_f) * (d - prev_d);
         prev_d = d;
@@ -117,7 +147,10 @@ fn elastic_plastic_loading_unloading_loop() {
     assert!((h.delta_p - dp).abs() < 1e-12 * dmax);
     let w_exact = 0.5 * law.k_e * uy * uy + law.f_y * (dmax - uy) + 0.5 * law.k_p * (dmax - uy).powi(2)
         - fmax * fmax / (2.0 * law.k_e);
-    assert!((work - w_exact).abs() / w_exact < 1e-3, "loop work {work}, analytic {w_exact}");
+    assert!(
+        (work - w_exact).abs() / w_exact < 1e-3,
+        "loop work {work}, analytic {w_exact}"
+    );
 }
 
 /// Parallel bond (Potyondy & Cundall 2004): pulled apart at constant speed, the normal force grows
@@ -126,13 +159,31 @@ fn elastic_plastic_loading_unloading_loop() {
 #[test]
 fn bond_breaks_at_its_strength() {
     // Su et al. 2020 Table 1: k̄_n = 13 N/m², κ = 2, λ̄ = 0.5; strengths chosen to break in range.
-    let p = BondParams { k_n: 13.0, k_s: 6.5, sigma_c: 2e-4, cohesion: 1e-4, lambda: 0.5 };
+    let p = BondParams {
+        k_n: 13.0,
+        k_s: 6.5,
+        sigma_c: 2e-4,
+        cohesion: 1e-4,
+        lambda: 0.5,
+    };
     let (r, dt, v) = (30e-6, 1e-3, 1e-6);
     for shear in [false, true] {
         let mut b = Bond::new(0, 1);
         let n = Vec2::new(1.0, 0.0);
-        let v_rel = if shear { Vec2::new(0.0, v) } else { Vec2::new(-v, 0.0) };
-        let c = ContactInput { delta: 0.0, n, v_rel, w_rel: 0.0, r_eff: 0.5 * r, m_eff: 0.0, dt };
+        let v_rel = if shear {
+            Vec2::new(0.0, v)
+        } else {
+            Vec2::new(-v, 0.0)
+        };
+        let c = ContactInput {
+            delta: 0.0,
+            n,
+            v_rel,
+            w_rel: 0.0,
+            r_eff: 0.5 * r,
+            m_eff: 0.0,
+            dt,
+        };
         let mut u = 0.0;
         while !b.broken && u < 1.0 {
             let (f, _) = b.update(&p, &c, r, r);
@@ -144,8 +195,15 @@ fn bond_breaks_at_its_strength() {
             }
             u += v * dt;
         }
-        let u_break = if shear { p.cohesion / p.k_s } else { p.sigma_c / p.k_n };
+        let u_break = if shear {
+            p.cohesion / p.k_s
+        } else {
+            p.sigma_c / p.k_n
+        };
         assert!(b.broken);
-        assert!((u - u_break).abs() <= v * dt * 1.0001, "broke at u = {u}, analytic {u_break}");
+        assert!(
+            (u - u_break).abs() <= v * dt * 1.0001,
+            "broke at u = {u}, analytic {u_break}"
+        );
     }
 }

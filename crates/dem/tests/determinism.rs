@@ -10,7 +10,10 @@ fn packing() -> (System, LinearSpringDashpot, StepParams) {
     // 30 x 30 bidisperse disks (d = 1, 1.4) compressed toward φ = 0.8 in a periodic box.
     let mut s = generate::bidisperse_lattice(30, 1.0, 1.4, 1.42, 11).unwrap();
     let mut law = LinearSpringDashpot::new(2e4, 2e4 * 2.0 / 7.0, Damping::Gamma(100.0), 0.5);
-    law.rolling = Some(Rolling { k_r: 100.0, mu_r: 0.1 });
+    law.rolling = Some(Rolling {
+        k_r: 100.0,
+        mu_r: 0.1,
+    });
     let p = StepParams::new(2.5e-4, 0.1);
     let mut st = Stepper::new();
     generate::compress_periodic(&mut s, &law, &p, 0.8, 1500, &mut st).unwrap();
@@ -29,7 +32,10 @@ fn run(s: &mut System, law: &LinearSpringDashpot, p: &StepParams, n: usize) {
 fn identical_for_one_and_two_threads() {
     let (s0, law, p) = packing();
     let go = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let mut s = s0.clone();
             // Keep shearing a little so contacts slide and the list is rebuilt.
@@ -44,7 +50,10 @@ fn identical_for_one_and_two_threads() {
         })
     };
     let (a, b) = (go(1), go(2));
-    assert!(a.contacts.hist.iter().any(|h| h.xi_t.norm() > 0.0), "test must exercise tangential history");
+    assert!(
+        a.contacts.hist.iter().any(|h| h.xi_t.norm() > 0.0),
+        "test must exercise tangential history"
+    );
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.contacts, b.contacts);
 }
@@ -75,18 +84,36 @@ fn cell_list_matches_brute_force() {
     let pos: Vec<Vec2> = (0..b.n_circles()).map(|c| b.circle_pos(c)).collect();
     for dom in [s.domain, Domain::open(s.domain.lo, s.domain.hi)] {
         let mut cl = CellList::default();
-        let got = cl.build_pairs(&dom, &pos, &b.circle_r, &b.circle_body, 0.1).unwrap();
+        let got = cl
+            .build_pairs(&dom, &pos, &b.circle_r, &b.circle_body, 0.1)
+            .unwrap();
         let want = brute_force_pairs(&dom, &pos, &b.circle_r, &b.circle_body, 0.1);
         assert_eq!(got, want);
     }
-    let two = ClumpShape { balls: vec![Ball { centre: Vec2::new(-0.3, 0.0), r: 0.5 }, Ball { centre: Vec2::new(0.3, 0.0), r: 0.4 }] };
+    let two = ClumpShape {
+        balls: vec![
+            Ball {
+                centre: Vec2::new(-0.3, 0.0),
+                r: 0.5,
+            },
+            Ball {
+                centre: Vec2::new(0.3, 0.0),
+                r: 0.4,
+            },
+        ],
+    };
     let lo = Vec2::new(0.0, 0.0);
     let hi = Vec2::new(15.0, 15.0);
     let c = generate::random_insert(&[two, ClumpShape::disk(0.4)], &[2.0, 1.0], 1.0, lo, hi, 60, 5).unwrap();
     let pos: Vec<Vec2> = (0..c.n_circles()).map(|k| c.circle_pos(k)).collect();
     let mut cl = CellList::default();
-    let got = cl.build_pairs(&Domain::open(lo, hi), &pos, &c.circle_r, &c.circle_body, 0.5).unwrap();
-    assert_eq!(got, brute_force_pairs(&Domain::open(lo, hi), &pos, &c.circle_r, &c.circle_body, 0.5));
+    let got = cl
+        .build_pairs(&Domain::open(lo, hi), &pos, &c.circle_r, &c.circle_body, 0.5)
+        .unwrap();
+    assert_eq!(
+        got,
+        brute_force_pairs(&Domain::open(lo, hi), &pos, &c.circle_r, &c.circle_body, 0.5)
+    );
     assert!(!got.is_empty());
 }
 
@@ -99,7 +126,10 @@ fn step_above_critical_is_refused() {
     let err = Stepper::new().step(&p, &law, &law, &mut s).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, DemError::TimeStepTooLarge { .. }));
-    assert!(msg.contains(&format!("{:e}", 1.5 * crit)) && msg.contains(&format!("{crit:e}")), "{msg}");
+    assert!(
+        msg.contains(&format!("{:e}", 1.5 * crit)) && msg.contains(&format!("{crit:e}")),
+        "{msg}"
+    );
 }
 
 /// Su et al. 2020 Sect. 2.4 membrane: inward force F_N only beyond the outward threshold.
@@ -108,7 +138,8 @@ fn membrane_pushes_back_only_beyond_threshold() {
     let mut b = Bodies::new();
     for k in 0..8 {
         let a = k as f64 * std::f64::consts::TAU / 8.0;
-        b.add(&ClumpShape::disk(0.1), 1.0, Vec2::new(a.cos(), a.sin()), 0.0).unwrap();
+        b.add(&ClumpShape::disk(0.1), 1.0, Vec2::new(a.cos(), a.sin()), 0.0)
+            .unwrap();
     }
     let m = Membrane::new((0..8).collect(), &b, 0.05, 2.0);
     assert_eq!(m.force_on(0, Vec2::new(1.04, 0.0)), Vec2::ZERO);

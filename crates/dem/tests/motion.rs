@@ -21,7 +21,18 @@ fn segment(r: f64, alpha: f64) -> (f64, f64, f64) {
 #[test]
 fn two_circle_clump_mass_and_inertia() {
     let (r1, r2, s) = (1.0, 0.7, 1.2);
-    let shape = ClumpShape { balls: vec![Ball { centre: Vec2::new(0.0, 0.0), r: r1 }, Ball { centre: Vec2::new(s, 0.0), r: r2 }] };
+    let shape = ClumpShape {
+        balls: vec![
+            Ball {
+                centre: Vec2::new(0.0, 0.0),
+                r: r1,
+            },
+            Ball {
+                centre: Vec2::new(s, 0.0),
+                r: r2,
+            },
+        ],
+    };
     let mp = shape.mass_props().unwrap();
     // Chord abscissa from circle 1.
     let l = (r1 * r1 - r2 * r2 + s * s) / (2.0 * s);
@@ -36,9 +47,19 @@ fn two_circle_clump_mass_and_inertia() {
     let cx = (c2 * s - lens * lens_cx) / area;
     let j0 = 0.5 * c1 * r1 * r1 + (0.5 * c2 * r2 * r2 + c2 * s * s) - lens_j0;
     let jc = j0 - area * cx * cx;
-    assert!((mp.area - area).abs() / area < 1e-8, "area {} vs {}", mp.area, area);
+    assert!(
+        (mp.area - area).abs() / area < 1e-8,
+        "area {} vs {}",
+        mp.area,
+        area
+    );
     assert!((mp.centroid.x - cx).abs() < 1e-8 && mp.centroid.y.abs() < 1e-10);
-    assert!((mp.polar_moment - jc).abs() / jc < 1e-8, "J {} vs {}", mp.polar_moment, jc);
+    assert!(
+        (mp.polar_moment - jc).abs() / jc < 1e-8,
+        "J {} vs {}",
+        mp.polar_moment,
+        jc
+    );
     // A single disk is the one-circle case: J = π r⁴/2.
     let d = ClumpShape::disk(0.3).mass_props().unwrap();
     assert!((d.polar_moment - PI * 0.3f64.powi(4) / 2.0).abs() < 1e-15);
@@ -48,7 +69,12 @@ fn incline_run(tan_theta: f64, mu: f64) -> (f64, f64, f64) {
     // A three-circle clump lying flat on a plane (it would tip only for tanθ > 2), gravity tilted.
     let r = 0.5;
     let shape = ClumpShape {
-        balls: (-1..=1).map(|k| Ball { centre: Vec2::new(2.0 * r * k as f64 * 0.9, 0.0), r }).collect(),
+        balls: (-1..=1)
+            .map(|k| Ball {
+                centre: Vec2::new(2.0 * r * k as f64 * 0.9, 0.0),
+                r,
+            })
+            .collect(),
     };
     let theta = tan_theta.atan();
     let g = 9.81;
@@ -85,7 +111,10 @@ fn incline_sticks_below_mu_and_slides_above() {
     assert!(a.abs() < 1e-6, "sticking acceleration {a}");
     let (x, a, a_exact) = incline_run(0.6, mu);
     assert!(x > 0.1, "tanθ = 0.6 > μ: must slide, moved {x}");
-    assert!((a - a_exact).abs() / a_exact < 1e-3, "sliding acceleration {a}, analytic {a_exact}");
+    assert!(
+        (a - a_exact).abs() / a_exact < 1e-3,
+        "sliding acceleration {a}, analytic {a_exact}"
+    );
 }
 
 /// Rolling resistance (linear rolling spring with limit μ_r r F_n, Ai et al., Powder Technol. 206
@@ -98,13 +127,18 @@ fn rolling_resistance_stops_disk_at_analytic_distance() {
     let mut bodies = Bodies::new();
     let m = PI * r * r;
     let delta0 = m * g / k;
-    bodies.add(&ClumpShape::disk(r), 1.0, Vec2::new(0.0, r - delta0), 0.0).unwrap();
+    bodies
+        .add(&ClumpShape::disk(r), 1.0, Vec2::new(0.0, r - delta0), 0.0)
+        .unwrap();
     bodies.vel[0] = Vec2::new(v0, 0.0);
     bodies.omega[0] = -v0 / r;
     let mut s = System::new(bodies, Domain::open(Vec2::new(-5.0, -5.0), Vec2::new(5.0, 5.0)));
     s.walls.push(Wall::plane(Vec2::ZERO, Vec2::new(0.0, 1.0)));
     let mut law = LinearSpringDashpot::new(k, k / 2.0, Damping::Ratio(0.7), 0.8);
-    law.rolling = Some(Rolling { k_r: 0.05 * k * r * r, mu_r });
+    law.rolling = Some(Rolling {
+        k_r: 0.05 * k * r * r,
+        mu_r,
+    });
     let mut p = StepParams::new(5e-5, 0.05);
     p.gravity = Vec2::new(0.0, -g);
     let mut st = Stepper::new();
@@ -116,8 +150,15 @@ fn rolling_resistance_stops_disk_at_analytic_distance() {
     let s_exact = 3.0 * v0 * v0 / (4.0 * mu_r * g);
     let x = s.bodies.pos[0].x;
     // After stopping, the undamped rolling spring leaves a small elastic rocking.
-    assert!(s.bodies.vel[0].x.abs() < 1e-2 * v0, "disk still moving: {}", s.bodies.vel[0].x);
-    assert!((x - s_exact).abs() / s_exact < 0.01, "stopped at {x}, analytic {s_exact}");
+    assert!(
+        s.bodies.vel[0].x.abs() < 1e-2 * v0,
+        "disk still moving: {}",
+        s.bodies.vel[0].x
+    );
+    assert!(
+        (x - s_exact).abs() / s_exact < 0.01,
+        "stopped at {x}, analytic {s_exact}"
+    );
 }
 
 fn energy(s: &System, k: f64) -> f64 {

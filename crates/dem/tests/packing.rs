@@ -94,7 +94,12 @@ fn compress(n: usize, mu: f64, seed: u64) -> (f64, System, LinearSpringDashpot, 
         _ => 0.0,
     };
     let m = 4.2;
-    let phi = window_fraction(&s, Vec2::new(x0 + m, y0 + m), Vec2::new(x0 + gx - m, y0 + gy - m), 0.04);
+    let phi = window_fraction(
+        &s,
+        Vec2::new(x0 + m, y0 + m),
+        Vec2::new(x0 + gx - m, y0 + gy - m),
+        0.04,
+    );
     (phi, s, law, p)
 }
 
@@ -102,15 +107,24 @@ fn check(n: usize) {
     let (phi0, ..) = compress(n, 0.0, 21);
     let (phi_f, mut s, law, p) = compress(n, 0.5, 21);
     eprintln!("N = {n}: frictionless φ = {phi0:.4}, μ = 0.5 φ = {phi_f:.4}");
-    assert!((phi0 - 0.84).abs() < 0.02, "frictionless φ = {phi0}, published φ_J ≈ 0.84");
-    assert!(phi_f < phi0 - 0.01, "frictional φ = {phi_f} must be below frictionless {phi0}");
+    assert!(
+        (phi0 - 0.84).abs() < 0.02,
+        "frictionless φ = {phi0}, published φ_J ≈ 0.84"
+    );
+    assert!(
+        phi_f < phi0 - 0.01,
+        "frictional φ = {phi_f} must be below frictionless {phi0}"
+    );
     // Then radius scaling to a target packing fraction and relaxation (Su Sect. 2.4).
     let target = s.packing_fraction() * 0.99;
     generate::scale_to_packing(&mut s, target);
     assert!((s.packing_fraction() - target).abs() < 1e-12);
     let mut st = Stepper::new();
     // Grains freed by the shrink fly without contact forces: damp them viscously.
-    let p = StepParams { viscous_damping: 5.0, ..p };
+    let p = StepParams {
+        viscous_damping: 5.0,
+        ..p
+    };
     let steps = generate::relax(&mut s, &law, &law, &p, 1e-4, 100_000, &mut st).unwrap();
     assert!(s.bodies.max_speed() < 1e-4, "still moving after {steps} steps");
 }

@@ -183,16 +183,29 @@ impl DryScene {
                     .templates
                     .iter()
                     .map(|t| ClumpShape {
-                        balls: t.circles.iter().map(|c| Ball { centre: Vec2::new(c[0], c[1]), r: c[2] }).collect(),
+                        balls: t
+                            .circles
+                            .iter()
+                            .map(|c| Ball {
+                                centre: Vec2::new(c[0], c[1]),
+                                r: c[2],
+                            })
+                            .collect(),
                     })
                     .collect();
                 let w: Vec<f64> = g.templates.iter().map(|t| t.weight).collect();
                 generate::random_insert(&shapes, &w, pc.density, v(g.lo), v(g.hi), g.count, g.seed)?
             }
-            _ => bail!("dry scene [particles]: give exactly one of csv = \"FILE.csv\" or a [particles.generate] table"),
+            _ => bail!(
+                "dry scene [particles]: give exactly one of csv = \"FILE.csv\" or a [particles.generate] table"
+            ),
         };
         let d = &self.domain;
-        let domain = Domain { lo: v(d.lo), hi: v(d.hi), periodic: d.periodic };
+        let domain = Domain {
+            lo: v(d.lo),
+            hi: v(d.hi),
+            periodic: d.periodic,
+        };
         let mut sys = System::new(bodies, domain);
         for (k, w) in self.walls.iter().enumerate() {
             let motion = match w.velocity {
@@ -200,9 +213,10 @@ impl DryScene {
                 None => WallMotion::Fixed,
             };
             match (w.box_, w.p, w.n, w.a, w.b) {
-                (Some(bx), None, None, None, None) => {
-                    sys.walls.extend(generate::box_walls(Vec2::new(bx[0], bx[1]), Vec2::new(bx[2], bx[3])))
-                }
+                (Some(bx), None, None, None, None) => sys.walls.extend(generate::box_walls(
+                    Vec2::new(bx[0], bx[1]),
+                    Vec2::new(bx[2], bx[3]),
+                )),
                 (None, Some(p), Some(n), None, None) => {
                     let mut wall = Wall::plane(v(p), v(n));
                     wall.motion = motion;
@@ -212,22 +226,31 @@ impl DryScene {
                     };
                     sys.walls.push(wall)
                 }
-                (None, None, None, Some(a), Some(b)) => {
-                    sys.walls.push(Wall::new(WallShape::Segment { a: v(a), b: v(b) }, motion))
-                }
-                _ => bail!("dry scene [[walls]] #{k}: give either box = [x0, y0, x1, y1], or p and n (plane), or a and b (segment)"),
+                (None, None, None, Some(a), Some(b)) => sys
+                    .walls
+                    .push(Wall::new(WallShape::Segment { a: v(a), b: v(b) }, motion)),
+                _ => bail!(
+                    "dry scene [[walls]] #{k}: give either box = [x0, y0, x1, y1], or p and n (plane), or a and b (segment)"
+                ),
             }
         }
         if let Some(m) = &self.membrane {
             let b = &sys.bodies;
             let (lo, hi) = (
-                b.pos.iter().fold(Vec2::new(f64::MAX, f64::MAX), |a, p| Vec2::new(a.x.min(p.x), a.y.min(p.y))),
-                b.pos.iter().fold(Vec2::new(f64::MIN, f64::MIN), |a, p| Vec2::new(a.x.max(p.x), a.y.max(p.y))),
+                b.pos.iter().fold(Vec2::new(f64::MAX, f64::MAX), |a, p| {
+                    Vec2::new(a.x.min(p.x), a.y.min(p.y))
+                }),
+                b.pos.iter().fold(Vec2::new(f64::MIN, f64::MIN), |a, p| {
+                    Vec2::new(a.x.max(p.x), a.y.max(p.y))
+                }),
             );
             let members: Vec<u32> = (0..b.len())
                 .filter(|&k| {
                     let p = b.pos[k];
-                    p.x - lo.x < m.shell || hi.x - p.x < m.shell || p.y - lo.y < m.shell || hi.y - p.y < m.shell
+                    p.x - lo.x < m.shell
+                        || hi.x - p.x < m.shell
+                        || p.y - lo.y < m.shell
+                        || hi.y - p.y < m.shell
                 })
                 .map(|k| k as u32)
                 .collect();
@@ -242,7 +265,8 @@ impl DryScene {
                             for cj in b.circle_start[j as usize]..b.circle_start[j as usize + 1] {
                                 let d = (b.circle_pos(cj) - b.circle_pos(ci)).norm();
                                 if d < b.circle_r[ci] + b.circle_r[cj] + bc.gap {
-                                    sys.bonds.push(lbdem_dem::contact::Bond::new(ci as u32, cj as u32));
+                                    sys.bonds
+                                        .push(lbdem_dem::contact::Bond::new(ci as u32, cj as u32));
                                 }
                             }
                         }

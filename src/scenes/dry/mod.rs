@@ -38,9 +38,10 @@ struct Checkpoint {
 }
 
 pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
-    let cfg: DryScene = scene.clone().try_into().context(
-        "dry scene: the file does not match the dry-scene format (see docs/dem.md for every key)",
-    )?;
+    let cfg: DryScene = scene
+        .clone()
+        .try_into()
+        .context("dry scene: the file does not match the dry-scene format (see docs/dem.md for every key)")?;
     std::fs::create_dir_all(ctx.out_dir.join("snapshots"))
         .with_context(|| format!("cannot create {}", ctx.out_dir.display()))?;
     let ck_path = ctx.out_dir.join("checkpoint.json");
@@ -48,9 +49,16 @@ pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
         let text = std::fs::read_to_string(&ck_path)
             .with_context(|| format!("cannot read checkpoint {}", ck_path.display()))?;
         let ck: Checkpoint = serde_json::from_str(&text).with_context(|| {
-            format!("checkpoint {} is damaged; delete it and run without --resume", ck_path.display())
+            format!(
+                "checkpoint {} is damaged; delete it and run without --resume",
+                ck_path.display()
+            )
         })?;
-        eprintln!("dry: resuming at step {} from {}", ck.system.step, ck_path.display());
+        eprintln!(
+            "dry: resuming at step {} from {}",
+            ck.system.step,
+            ck_path.display()
+        );
         (ck.system, ck.rows, ck.snapshots)
     } else {
         (cfg.build_system(&ctx.base_dir)?, Vec::new(), Vec::new())
@@ -60,13 +68,22 @@ pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
     let p = cfg.step;
     let mut st = Stepper::new();
     let (crit, m_min, k_max) = Stepper::critical_time_step(&sys, &law, &wall_law);
-    eprintln!("dry: {} bodies, dt = {:e} s, critical {:e} s (m_min {m_min:e} kg, k_max {k_max:e} N/m)", sys.bodies.len(), p.dt, crit);
+    eprintln!(
+        "dry: {} bodies, dt = {:e} s, critical {:e} s (m_min {m_min:e} kg, k_max {k_max:e} N/m)",
+        sys.bodies.len(),
+        p.dt,
+        crit
+    );
     if let Some(c) = &cfg.run.compress
         && sys.step == 0
     {
-        let n = lbdem_dem::generate::compress_isotropic(&mut sys, &law, &wall_law, &p, &c.to_kernel(), &mut st)
-            .context("dry scene [run.compress]")?;
-        eprintln!("dry: isotropic compression took {n} steps, packing fraction {:.4}", sys.packing_fraction());
+        let n =
+            lbdem_dem::generate::compress_isotropic(&mut sys, &law, &wall_law, &p, &c.to_kernel(), &mut st)
+                .context("dry scene [run.compress]")?;
+        eprintln!(
+            "dry: isotropic compression took {n} steps, packing fraction {:.4}",
+            sys.packing_fraction()
+        );
         if let Some(phi) = c.target_packing {
             lbdem_dem::generate::scale_to_packing(&mut sys, phi);
         }
@@ -85,9 +102,8 @@ pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
         wall_forces: sys.walls.iter().map(|w| [w.force.x, w.force.y]).collect(),
     };
     while sys.step < r.steps {
-        st.step_law(&p, &law, &wall_law, &mut sys).map_err(|e| {
-            anyhow::anyhow!("dry scene: {e} (set [step] dt in the scene file)")
-        })?;
+        st.step_law(&p, &law, &wall_law, &mut sys)
+            .map_err(|e| anyhow::anyhow!("dry scene: {e} (set [step] dt in the scene file)"))?;
         let n = sys.step;
         if n % r.output_every == 0 {
             rows.push(record(&sys, &st));
@@ -98,7 +114,11 @@ pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
             snaps.push((sys.time, name));
         }
         if r.checkpoint_every > 0 && n % r.checkpoint_every == 0 {
-            let ck = Checkpoint { system: sys.clone(), rows: rows.clone(), snapshots: snaps.clone() };
+            let ck = Checkpoint {
+                system: sys.clone(),
+                rows: rows.clone(),
+                snapshots: snaps.clone(),
+            };
             let text = serde_json::to_vec(&ck)?;
             write_atomic(&ck_path, &text).with_context(|| format!("cannot write {}", ck_path.display()))?;
             write_series(&ctx.out_dir, &rows)?;
@@ -136,7 +156,10 @@ pub fn run(scene: &toml::Value, ctx: &SimContext) -> Result<StageOutput> {
             "contact_law": law_name(&law), "critical_time_step": crit,
         }),
         figures: vec![],
-        tables: vec![Table { path: "series.csv".into(), caption: "DEM time series".into() }],
+        tables: vec![Table {
+            path: "series.csv".into(),
+            caption: "DEM time series".into(),
+        }],
         files,
     })
 }
@@ -176,10 +199,12 @@ fn write_series(dir: &Path, rows: &[Row]) -> Result<Vec<PathBuf>> {
 fn write_snapshot(path: &Path, sys: &System) -> Result<()> {
     let b = &sys.bodies;
     let nc = b.n_circles();
-    let pos: Vec<[f64; 3]> = (0..nc).map(|c| {
-        let p = b.circle_pos(c);
-        [p.x, p.y, 0.0]
-    }).collect();
+    let pos: Vec<[f64; 3]> = (0..nc)
+        .map(|c| {
+            let p = b.circle_pos(c);
+            [p.x, p.y, 0.0]
+        })
+        .collect();
     let body: Vec<i32> = b.circle_body.iter().map(|&k| k as i32).collect();
     let vel: Vec<f64> = (0..nc)
         .flat_map(|c| {

@@ -39,7 +39,14 @@ checkpoint_every = 1000
 
 fn run(text: &str, dir: &Path, resume: bool) -> anyhow::Result<crate::stages::StageOutput> {
     let v: toml::Value = toml::from_str(text)?;
-    super::run(&v, &SimContext { out_dir: dir.to_path_buf(), resume, base_dir: dir.to_path_buf() })
+    super::run(
+        &v,
+        &SimContext {
+            out_dir: dir.to_path_buf(),
+            resume,
+            base_dir: dir.to_path_buf(),
+        },
+    )
 }
 
 #[test]
@@ -47,8 +54,14 @@ fn resumed_run_matches_uninterrupted_bitwise() {
     let t = tempfile::tempdir().unwrap();
     let (a, b) = (t.path().join("whole"), t.path().join("killed"));
     run(SCENE, &a, false).unwrap();
-    let killed = SCENE.replace("checkpoint_every = 1000", "checkpoint_every = 1000\nstop_after_steps_for_test = 2500");
-    assert!(run(&killed, &b, false).is_err(), "the simulated interruption must stop the run");
+    let killed = SCENE.replace(
+        "checkpoint_every = 1000",
+        "checkpoint_every = 1000\nstop_after_steps_for_test = 2500",
+    );
+    assert!(
+        run(&killed, &b, false).is_err(),
+        "the simulated interruption must stop the run"
+    );
     run(SCENE, &b, true).unwrap();
     let load = |d: &Path| {
         lbdem_dem::System::from_checkpoint(&std::fs::read(d.join("final_state.json")).unwrap()).unwrap()
@@ -58,7 +71,13 @@ fn resumed_run_matches_uninterrupted_bitwise() {
     // not touch, which carry no force and no history).
     assert!(fa.bodies == fb.bodies && fa.walls == fb.walls && fa.step == fb.step && fa.time == fb.time);
     let touching = |s: &lbdem_dem::System| -> Vec<_> {
-        s.contacts.pairs.iter().zip(&s.contacts.hist).filter(|(_, h)| **h != Default::default()).map(|(p, h)| (*p, *h)).collect()
+        s.contacts
+            .pairs
+            .iter()
+            .zip(&s.contacts.hist)
+            .filter(|(_, h)| **h != Default::default())
+            .map(|(p, h)| (*p, *h))
+            .collect()
     };
     assert_eq!(touching(&fa), touching(&fb));
     let sa = std::fs::read(a.join("series.csv")).unwrap();
@@ -71,7 +90,11 @@ fn reads_digitised_circles_in_pixels() {
     let t = tempfile::tempdir().unwrap();
     let csv = t.path().join("grains.csv");
     std::fs::write(&csv, "grain_id,x,y,r\n0,10,10,4\n0,14,10,3\n1,30,30,5\n").unwrap();
-    std::fs::write(t.path().join("grains.json"), r#"{"units": "px", "pixel_size": 1.0e-5}"#).unwrap();
+    std::fs::write(
+        t.path().join("grains.json"),
+        r#"{"units": "px", "pixel_size": 1.0e-5}"#,
+    )
+    .unwrap();
     let b = super::particles::read_csv(&csv, 2.6).unwrap();
     assert_eq!(b.len(), 2);
     assert_eq!(b.n_circles(), 3);

@@ -40,7 +40,14 @@ pub struct Bond {
 
 impl Bond {
     pub fn new(i: u32, j: u32) -> Self {
-        Self { i, j, f_n: 0.0, f_s: 0.0, m: 0.0, broken: false }
+        Self {
+            i,
+            j,
+            f_n: 0.0,
+            f_s: 0.0,
+            m: 0.0,
+            broken: false,
+        }
     }
 
     /// Advance the bond by one step and return (force on i, torque on i about the contact);

@@ -47,8 +47,16 @@ impl ContactLaw for HertzMindlin {
         let f_n = (k * (c.delta * s + self.a_damp * s * vn)).max(0.0);
         let vt = c.v_rel - c.n * vn;
         let vtm = vt.norm();
-        let ft = if vtm > 0.0 { vt * (-(self.eta * vtm).min(self.mu * f_n) / vtm) } else { Vec2::ZERO };
-        ContactOutput { f: ft - c.n * f_n, m_roll: 0.0, f_n }
+        let ft = if vtm > 0.0 {
+            vt * (-(self.eta * vtm).min(self.mu * f_n) / vtm)
+        } else {
+            Vec2::ZERO
+        };
+        ContactOutput {
+            f: ft - c.n * f_n,
+            m_roll: 0.0,
+            f_n,
+        }
     }
     /// Tangent stiffness dF/dξ = (3/2) K √ξ at the largest expected overlap.
     fn max_stiffness(&self, r_eff: f64) -> f64 {

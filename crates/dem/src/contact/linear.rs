@@ -35,7 +35,15 @@ fn yes() -> bool {
 
 impl LinearSpringDashpot {
     pub fn new(k_n: f64, k_t: f64, damping: Damping, mu: f64) -> Self {
-        Self { k_n, k_t, damping, tangential_damping: 0.5, mu, rolling: None, clip: true }
+        Self {
+            k_n,
+            k_t,
+            damping,
+            tangential_damping: 0.5,
+            mu,
+            rolling: None,
+            clip: true,
+        }
     }
 }
 
@@ -57,7 +65,11 @@ impl ContactLaw for LinearSpringDashpot {
             Some(r) => r.torque(c, h, f_n),
             None => 0.0,
         };
-        ContactOutput { f: ft - c.n * f_n, m_roll, f_n }
+        ContactOutput {
+            f: ft - c.n * f_n,
+            m_roll,
+            f_n,
+        }
     }
     fn max_stiffness(&self, _r_eff: f64) -> f64 {
         self.k_n.max(self.k_t)

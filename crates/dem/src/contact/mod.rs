@@ -102,7 +102,11 @@ pub fn tangential(c: &ContactInput, h: &mut History, kt: f64, ct: f64, mu: f64, 
     let ftm = ft.norm();
     if ftm > lim {
         ft = if ftm > 0.0 { ft * (lim / ftm) } else { Vec2::ZERO };
-        xi = if kt > 0.0 { -(ft + vt * ct) * (1.0 / kt) } else { Vec2::ZERO };
+        xi = if kt > 0.0 {
+            -(ft + vt * ct) * (1.0 / kt)
+        } else {
+            Vec2::ZERO
+        };
     }
     h.xi_t = xi;
     ft

@@ -51,13 +51,25 @@ impl ContactLaw for ElasticPlastic {
         let f_el = self.normal(c.delta, h);
         let cn = self.damping.coefficient(self.k_e, c.m_eff);
         let vn = c.v_rel.x * c.n.x + c.v_rel.y * c.n.y;
-        let f_n = if f_el > 0.0 { (f_el + cn * vn).max(0.0) } else { 0.0 };
-        let ft = if self.mu > 0.0 { tangential(c, h, self.k_t, 0.5 * cn, self.mu, f_n) } else { Vec2::ZERO };
+        let f_n = if f_el > 0.0 {
+            (f_el + cn * vn).max(0.0)
+        } else {
+            0.0
+        };
+        let ft = if self.mu > 0.0 {
+            tangential(c, h, self.k_t, 0.5 * cn, self.mu, f_n)
+        } else {
+            Vec2::ZERO
+        };
         let m_roll = match &self.rolling {
             Some(r) => r.torque(c, h, f_n),
             None => 0.0,
         };
-        ContactOutput { f: ft - c.n * f_n, m_roll, f_n }
+        ContactOutput {
+            f: ft - c.n * f_n,
+            m_roll,
+            f_n,
+        }
     }
     fn max_stiffness(&self, _r_eff: f64) -> f64 {
         self.k_e.max(self.k_t)
