@@ -115,8 +115,14 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 z = zz;
             }
             let ours = median(&rates);
-            let (theirs, ratio) = if a.peer {
-                let lsteps = if *n_side > 100 { 2000 } else { 10000 };
+            // The LAMMPS 100k packing takes ~45,000 steps of 100k disks to prepare; it is used only
+            // if already prepared (scripts/peer-lammps.sh 316 2 2000 prepares it).
+            let peer_ready = *n_side <= 100
+                || Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join(format!("out/peer-lammps/lmp2d_n{n_side}.restart"))
+                    .exists();
+            let (theirs, ratio) = if a.peer && peer_ready {
+                let lsteps = if *n_side > 100 { 1000 } else { 4000 };
                 let mut pr = Vec::new();
                 for _ in 0..reps.min(3) {
                     pr.push(peer(*n_side, threads, lsteps)?);
