@@ -165,46 +165,14 @@ impl Stepper {
                 }
             }
         }
-        self.kick(sys, 0.5 * dt);
-        // Drift.
-        {
-            let b = &mut sys.bodies;
-            let dom = sys.domain;
-            b.pos
-                .par_iter_mut()
-                .zip(b.vel.par_iter())
-                .with_min_len(4096)
-                .for_each(|(x, v)| *x = dom.wrap(*x + *v * dt));
-            b.angle
-                .par_iter_mut()
-                .zip(b.omega.par_iter())
-                .with_min_len(4096)
-                .for_each(|(a, w)| *a += w * dt);
-        }
+        self.kick_drift(sys, 0.5 * dt, dt);
         update_wall_velocities(&mut sys.walls, wall_law.max_stiffness(1.0), dt);
         for w in sys.walls.iter_mut() {
             let v = w.vel;
             w.translate(v * dt);
         }
-        self.update_circles(sys);
+        let worst = self.update_circles(sys);
         let half_skin2 = 0.25 * p.skin * p.skin;
-        let dom = sys.domain;
-        let worst = self
-            .cpos
-            .par_iter()
-            .zip(self.ref_pos.par_iter())
-            .with_min_len(4096)
-            .map(|(a, b)| dom.min_image(*a - *b).norm2())
-            .reduce(
-                || 0.0,
-                |a, b| {
-                    if a.is_nan() || b.is_nan() {
-                        f64::NAN
-                    } else {
-                        a.max(b)
-                    }
-                },
-            );
         if !worst.is_finite() {
             let body = (0..sys.bodies.len())
                 .find(|&k| !(sys.bodies.pos[k].norm2().is_finite() && sys.bodies.vel[k].norm2().is_finite()))
@@ -221,6 +189,25 @@ impl Stepper {
         Ok(())
     }
 
+    /// Half kick then drift, fused in one pass over the bodies.
+    fn kick_drift(&self, sys: &mut System, h: f64, dt: f64) {
+        let dom = sys.domain;
+        let b = &mut sys.bodies;
+        let (force, mass, torque, inertia) = (&b.force, &b.mass, &b.torque, &b.inertia);
+        b.pos
+            .par_iter_mut()
+            .zip(b.vel.par_iter_mut())
+            .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(k, ((x, v), (a, w)))| {
+                *v += force[k] * (h / mass[k]);
+                *w += torque[k] * h / inertia[k];
+                *x = dom.wrap(*x + *v * dt);
+                *a += *w * dt;
+            });
+    }
+
     fn kick(&self, sys: &mut System, h: f64) {
         let b = &mut sys.bodies;
         b.vel
@@ -235,26 +222,38 @@ impl Stepper {
             .for_each(|(w, (t, i))| *w += t * h / i);
     }
 
-    fn update_circles(&mut self, sys: &System) {
+    /// World positions, arms and packed pair-loop state of every circle; returns the largest
+    /// squared displacement since the last list build (NaN if any position is not finite).
+    fn update_circles(&mut self, sys: &System) -> f64 {
         let b = &sys.bodies;
+        let dom = sys.domain;
         let nc = b.n_circles();
         self.cpos.resize(nc, Vec2::ZERO);
         self.carm.resize(nc, Vec2::ZERO);
+        self.cstate.resize(nc, CircleState::default());
+        let have_ref = self.ref_pos.len() == nc;
+        let refp = &self.ref_pos;
         self.cpos
             .par_iter_mut()
             .zip(self.carm.par_iter_mut())
+            .zip(self.cstate.par_iter_mut())
             .enumerate()
             .with_min_len(4096)
-            .for_each(|(c, (x, a))| {
+            .map(|(c, ((x, a), st))| {
                 let k = b.circle_body[c] as usize;
                 let off = b.circle_offset[c];
-                *a = if off.x == 0.0 && off.y == 0.0 {
-                    Vec2::ZERO
-                } else {
-                    off.rotated(b.angle[k])
-                };
+                *a = if off.x == 0.0 && off.y == 0.0 { Vec2::ZERO } else { off.rotated(b.angle[k]) };
                 *x = b.pos[k] + *a;
-            });
+                *st = CircleState {
+                    pos: *x,
+                    vel: b.vel[k] + a.spin(b.omega[k]),
+                    omega: b.omega[k],
+                    r: b.circle_r[c],
+                    mass: b.mass[k],
+                };
+                if have_ref { dom.min_image(*x - refp[c]).norm2() } else { x.norm2() * 0.0 }
+            })
+            .reduce(|| 0.0, |p, q| if p.is_nan() || q.is_nan() { f64::NAN } else { p.max(q) })
     }
 
     fn rebuild(&mut self, sys: &mut System, skin: f64) -> Result<(), DemError> {

@@ -82,25 +82,21 @@ impl Damping {
     }
 }
 
-/// Tangential spring with Coulomb limit (Cundall & Strack 1979; LAMMPS gran/hooke/history):
-/// the spring elongation is projected onto the current tangent plane, incremented by v_t dt,
+/// Tangential spring with Coulomb limit (Cundall & Strack 1979; LAMMPS pair gran/hooke/history):
+/// the spring elongation is projected onto the current tangent plane (as LAMMPS does, without
+/// restoring its length: a second-order effect in the rotation per step), incremented by v_t dt,
 /// and rescaled to the Coulomb limit μ F_n when sliding.
 #[inline]
 pub fn tangential(c: &ContactInput, h: &mut History, kt: f64, ct: f64, mu: f64, f_n: f64) -> Vec2 {
     let vn = c.v_rel.dot(c.n);
     let vt = c.v_rel - c.n * vn;
-    // Rotate the stored elongation into the current tangent plane, keeping its length.
-    let old = h.xi_t.norm2();
     let mut xi = h.xi_t - c.n * h.xi_t.dot(c.n);
-    let new = xi.norm2();
-    if new > 0.0 {
-        xi = xi * (old / new).sqrt();
-    }
     xi += vt * c.dt;
     let mut ft = -(xi * kt) - vt * ct;
     let lim = mu * f_n.max(0.0);
-    let ftm = ft.norm();
-    if ftm > lim {
+    let ftm2 = ft.norm2();
+    if ftm2 > lim * lim {
+        let ftm = ftm2.sqrt();
         ft = if ftm > 0.0 { ft * (lim / ftm) } else { Vec2::ZERO };
         xi = if kt > 0.0 {
             -(ft + vt * ct) * (1.0 / kt)
