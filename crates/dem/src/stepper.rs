@@ -161,7 +161,7 @@ impl Stepper {
                 self.rebuild(sys, p.skin)?;
                 if sys.step == 0 {
                     // Prime F(0) for the first half-kick; dt = 0 leaves the history untouched.
-                    self.forces(&StepParams { dt: 0.0, ..*p }, law, wall_law, sys);
+                    self.forces(&StepParams { dt: 0.0, ..*p }, law, wall_law, sys, 0.0);
                 }
             }
         }
@@ -182,8 +182,7 @@ impl Stepper {
         if worst > half_skin2 {
             self.rebuild(sys, p.skin)?;
         }
-        self.forces(p, law, wall_law, sys);
-        self.kick(sys, 0.5 * dt);
+        self.forces(p, law, wall_law, sys, 0.5 * dt);
         sys.time += dt;
         sys.step += 1;
         Ok(())
@@ -208,20 +207,6 @@ impl Stepper {
             });
     }
 
-    fn kick(&self, sys: &mut System, h: f64) {
-        let b = &mut sys.bodies;
-        b.vel
-            .par_iter_mut()
-            .zip(b.force.par_iter().zip(b.mass.par_iter()))
-            .with_min_len(4096)
-            .for_each(|(v, (f, m))| *v += *f * (h / m));
-        b.omega
-            .par_iter_mut()
-            .zip(b.torque.par_iter().zip(b.inertia.par_iter()))
-            .with_min_len(4096)
-            .for_each(|(w, (t, i))| *w += t * h / i);
-    }
-
     /// World positions, arms and packed pair-loop state of every circle; returns the largest
     /// squared displacement since the last list build (NaN if any position is not finite).
     fn update_circles(&mut self, sys: &System) -> f64 {
@@ -242,7 +227,11 @@ impl Stepper {
             .map(|(c, ((x, a), st))| {
                 let k = b.circle_body[c] as usize;
                 let off = b.circle_offset[c];
-                *a = if off.x == 0.0 && off.y == 0.0 { Vec2::ZERO } else { off.rotated(b.angle[k]) };
+                *a = if off.x == 0.0 && off.y == 0.0 {
+                    Vec2::ZERO
+                } else {
+                    off.rotated(b.angle[k])
+                };
                 *x = b.pos[k] + *a;
                 *st = CircleState {
                     pos: *x,
@@ -251,9 +240,22 @@ impl Stepper {
                     r: b.circle_r[c],
                     mass: b.mass[k],
                 };
-                if have_ref { dom.min_image(*x - refp[c]).norm2() } else { x.norm2() * 0.0 }
+                if have_ref {
+                    dom.min_image(*x - refp[c]).norm2()
+                } else {
+                    x.norm2() * 0.0
+                }
             })
-            .reduce(|| 0.0, |p, q| if p.is_nan() || q.is_nan() { f64::NAN } else { p.max(q) })
+            .reduce(
+                || 0.0,
+                |p, q| {
+                    if p.is_nan() || q.is_nan() {
+                        f64::NAN
+                    } else {
+                        p.max(q)
+                    }
+                },
+            )
     }
 
     fn rebuild(&mut self, sys: &mut System, skin: f64) -> Result<(), DemError> {
@@ -294,7 +296,8 @@ impl Stepper {
         Ok(())
     }
 
-    fn forces<L: ContactLaw>(&mut self, p: &StepParams, law: &L, wall_law: &L, sys: &mut System) {
+    /// Forces and torques on every body; then, if `h > 0`, the closing half kick v += F/m h.
+    fn forces<L: ContactLaw>(&mut self, p: &StepParams, law: &L, wall_law: &L, sys: &mut System, h: f64) {
         let dt = p.dt;
         let b = &sys.bodies;
         let dom = sys.domain;
@@ -358,16 +361,36 @@ impl Stepper {
                     touch: true,
                 };
             });
-        // 2. Gather per body in canonical order.
+        // 2. Gather per body in canonical order. Without walls, bonds or membrane nothing else
+        //    adds to the contact forces, so body forces, damping and the kick follow in the same pass.
+        let g = p.gravity * p.gravity_factor;
+        let fin = Finish {
+            g,
+            gv: p.viscous_damping,
+            al: p.local_damping,
+            h,
+        };
+        let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
         let (out, csr, cs) = (&self.out, &self.csr, &self.csr_start);
         let bodies = &mut sys.bodies;
-        let (cstart, force, torque) = (&bodies.circle_start, &mut bodies.force, &mut bodies.torque);
+        let Bodies5 {
+            force,
+            torque,
+            vel,
+            omega,
+            mass,
+            inertia,
+            ext_force,
+            ext_torque,
+            cstart,
+        } = Bodies5::of(bodies);
         force
             .par_iter_mut()
             .zip(torque.par_iter_mut())
+            .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
             .enumerate()
             .with_min_len(512)
-            .for_each(|(k, (f, t))| {
+            .for_each(|(k, ((f, t), (v, w)))| {
                 let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
                 for c in cstart[k]..cstart[k + 1] {
                     let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
@@ -386,7 +409,13 @@ impl Stepper {
                 }
                 *f = fb;
                 *t = tb;
+                if simple {
+                    fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
+                }
             });
+        if simple {
+            return;
+        }
         // 3. Walls: per circle in parallel, then a sequential sum in circle order.
         let nw = sys.walls.len();
         if nw > 0 {
@@ -485,8 +514,6 @@ impl Stepper {
                 bodies.force[bk] += f;
             }
         }
-        let g = p.gravity * p.gravity_factor;
-        let (gv, al) = (p.viscous_damping, p.local_damping);
         let Bodies5 {
             force,
             torque,
@@ -496,25 +523,47 @@ impl Stepper {
             inertia,
             ext_force,
             ext_torque,
+            ..
         } = Bodies5::of(bodies);
         force
             .par_iter_mut()
             .zip(torque.par_iter_mut())
+            .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
             .enumerate()
             .with_min_len(1024)
-            .for_each(|(k, (f, t))| {
-                *f += g * mass[k] + ext_force[k];
-                *t += ext_torque[k];
-                if gv > 0.0 {
-                    *f -= vel[k] * (gv * mass[k]);
-                    *t -= gv * inertia[k] * omega[k];
-                }
-                if al > 0.0 {
-                    f.x -= al * f.x.abs() * sign(vel[k].x);
-                    f.y -= al * f.y.abs() * sign(vel[k].y);
-                    *t -= al * t.abs() * sign(omega[k]);
-                }
+            .for_each(|(k, ((f, t), (v, w)))| {
+                fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
             });
+    }
+}
+
+/// Body forces, damping and the closing half kick for one body.
+struct Finish {
+    g: Vec2,
+    gv: f64,
+    al: f64,
+    h: f64,
+}
+
+impl Finish {
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn apply(&self, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64, m: f64, i: f64, ef: Vec2, et: f64) {
+        *f += self.g * m + ef;
+        *t += et;
+        if self.gv > 0.0 {
+            *f -= *v * (self.gv * m);
+            *t -= self.gv * i * *w;
+        }
+        if self.al > 0.0 {
+            f.x -= self.al * f.x.abs() * sign(v.x);
+            f.y -= self.al * f.y.abs() * sign(v.y);
+            *t -= self.al * t.abs() * sign(*w);
+        }
+        if self.h != 0.0 {
+            *v += *f * (self.h / m);
+            *w += *t * self.h / i;
+        }
     }
 }
 
@@ -529,16 +578,17 @@ fn sign(x: f64) -> f64 {
     }
 }
 
-/// Split borrows of the fields the last force pass needs.
+/// Split borrows of the fields the force passes need.
 struct Bodies5<'a> {
     force: &'a mut Vec<Vec2>,
     torque: &'a mut Vec<f64>,
-    vel: &'a [Vec2],
-    omega: &'a [f64],
+    vel: &'a mut Vec<Vec2>,
+    omega: &'a mut Vec<f64>,
     mass: &'a [f64],
     inertia: &'a [f64],
     ext_force: &'a [Vec2],
     ext_torque: &'a [f64],
+    cstart: &'a [usize],
 }
 
 impl<'a> Bodies5<'a> {
@@ -546,12 +596,13 @@ impl<'a> Bodies5<'a> {
         Self {
             force: &mut b.force,
             torque: &mut b.torque,
-            vel: &b.vel,
-            omega: &b.omega,
+            vel: &mut b.vel,
+            omega: &mut b.omega,
             mass: &b.mass,
             inertia: &b.inertia,
             ext_force: &b.ext_force,
             ext_torque: &b.ext_torque,
+            cstart: &b.circle_start,
         }
     }
 }
