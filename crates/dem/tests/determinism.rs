@@ -147,3 +147,29 @@ fn membrane_pushes_back_only_beyond_threshold() {
     let f = m.force_on(0, Vec2::new(1.06, 0.0));
     assert!((f.x + 2.0).abs() < 1e-12 && f.y.abs() < 1e-12);
 }
+
+/// Su et al. 2020 Sect. 2.4 packing-fraction adjustment: deleting grains lowers φ by exactly
+/// their area; grains added into interstices do not overlap anything.
+#[test]
+fn grain_removal_and_addition_change_packing_fraction() {
+    let shapes = [ClumpShape::disk(0.5), ClumpShape::disk(0.7)];
+    let (lo, hi) = (Vec2::ZERO, Vec2::new(20.0, 20.0));
+    let bodies = generate::random_insert(&shapes, &[1.0, 1.0], 1.0, lo, hi, 150, 9).unwrap();
+    let mut s = System::new(bodies, Domain::open(lo, hi));
+    s.walls = generate::box_walls(lo, hi);
+    let (n0, phi0) = (s.bodies.len(), s.packing_fraction());
+    generate::remove_random(&mut s, 10, 1);
+    assert_eq!(s.bodies.len(), n0 - 10);
+    assert!(s.packing_fraction() < phi0);
+    let phi1 = s.packing_fraction();
+    let added = generate::add_in_voids(&mut s, &ClumpShape::disk(0.3), 1.0, 20, 2).unwrap();
+    assert_eq!(added, 20);
+    let expect = phi1 + 20.0 * std::f64::consts::PI * 0.09 / 400.0;
+    assert!((s.packing_fraction() - expect).abs() < 1e-12);
+    let b = &s.bodies;
+    for i in 0..b.n_circles() {
+        for j in i + 1..b.n_circles() {
+            assert!((b.circle_pos(j) - b.circle_pos(i)).norm() >= b.circle_r[i] + b.circle_r[j]);
+        }
+    }
+}
