@@ -8,6 +8,7 @@
 
 pub mod bench;
 pub mod cli;
+pub mod io;
 pub mod pipeline;
 pub mod report;
 pub mod scenes;

@@ -1,8 +1,117 @@
-//! `lbdem bench radiograph` (work in progress on its issue branch).
+//! `lbdem bench radiograph`: frames per second from a raw 2048 x 2048 16-bit frame to the
+//! REV g_S map (Eq. 4b, summed-area table) and the eps_vol map (Eq. 5), with the thickness
+//! of each frame from Eq. (2) over a liquid ROI; and the ratio of the bytes those passes
+//! move per second to the STREAM triad bandwidth measured in the same run.
+//!
+//! Bytes counted per pixel (STREAM convention: reads plus writes, no write-allocate):
+//! u16 frame read 2, SAT row pass write 8, column pass read+write 16, REV window pass
+//! read 2 x 8 (top and bottom rows) + write 8, Eq. (5) read 2 x 8 + write 8: 74 B/px.
 
-use super::BenchArgs;
-use anyhow::{Result, bail};
+use super::{BenchArgs, bandwidth, median};
+use anyhow::Result;
+use lbdem_imaging::Roi;
+use lbdem_imaging::beer_lambert::{self as bl, FractionMap};
+use lbdem_imaging::rev::Sat;
+use lbdem_imaging::synth::{self, Beam, GrainShape};
+use ndarray::Array2;
+use std::time::Instant;
 
-pub fn run(_a: &BenchArgs) -> Result<()> {
-    bail!("bench radiograph is not built yet")
+const BYTES_PER_PX: f64 = 74.0;
+
+/// Synthetic raw frames (frame 0 and a 5% thinner frame) of `n` x `n` px.
+fn frames(n: usize) -> Result<Vec<Array2<u16>>> {
+    let d = n as f64 / 60.0;
+    let region = Roi::new(0, n / 16, n, n - n / 8);
+    let disks = synth::pack_disks(region, d, 0.2, 0.45, 7)?;
+    let beam = Beam {
+        i0: 30000.0,
+        mu_s: 2147.85,
+        mu_l: 10120.559,
+    };
+    let mut out = Vec::new();
+    for (k, l) in [150e-6, 142.5e-6].into_iter().enumerate() {
+        let px = 6e-6 * 1024.0 / n as f64;
+        let (_, counts) = synth::render(
+            n,
+            n,
+            &disks,
+            1,
+            GrainShape::TruncatedSphere,
+            l / px,
+            l,
+            &beam,
+            &[],
+            &[],
+        );
+        out.push(synth::noisy_u16(counts.view(), 11 + k as u64)?);
+    }
+    Ok(out)
+}
+
+fn roi_mean(f: &Array2<u16>, r: Roi) -> f64 {
+    let v = f.slice(ndarray::s![r.y..r.y + r.h, r.x..r.x + r.w]);
+    v.iter().map(|&c| c as f64).sum::<f64>() / v.len() as f64
+}
+
+/// Seconds per frame (median of `reps`), on a pool of `threads`.
+fn time_frames(threads: usize, raw: &[Array2<u16>], reps: usize) -> Result<f64> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+    pool.install(|| {
+        let (h, w) = raw[0].dim();
+        let side = (10f64.sqrt() * 30.0 * h as f64 / 1024.0).round() as usize;
+        let (mu_s, mu_l, l0) = (2147.85, 10120.559, 150e-6);
+        let liquid = Roi::new(16, h - h / 32, w - 32, h / 32 - 2);
+        let solid_like = Roi::new(16, 2, w - 32, h / 32 - 2);
+        let (i_l0, i_s0) = (roi_mean(&raw[0], liquid), roi_mean(&raw[0], solid_like).max(1.0));
+        let mut sat = Sat::new();
+        let mut g0 = Array2::zeros((h, w));
+        let mut gn = Array2::zeros((h, w));
+        let mut eps = Array2::zeros((h, w));
+        sat.build_u16(raw[0].view(), &FractionMap::eq1(i_l0, i_s0)?.lut_u16());
+        sat.rev_mean_into(side, 0.5, &mut g0)?;
+        let mut per_frame = Vec::new();
+        for _ in 0..reps.max(1) {
+            let frames = 4;
+            let t = Instant::now();
+            for k in 0..frames {
+                let f = &raw[1 + k % (raw.len() - 1)];
+                let ln_ = bl::thickness_eq2(l0, mu_s, mu_l, i_l0, roi_mean(f, liquid), 0.0, 0.0);
+                let map = FractionMap::eq4(i_l0, mu_s, mu_l, l0, ln_)?;
+                sat.build_u16(f.view(), &map.lut_u16());
+                sat.rev_mean_into(side, 0.5, &mut gn)?;
+                bl::eps_vol_into(g0.view(), gn.view(), 0.1, &mut eps);
+            }
+            per_frame.push(t.elapsed().as_secs_f64() / frames as f64);
+            std::hint::black_box(&eps);
+        }
+        Ok(median(&per_frame))
+    })
+}
+
+pub fn run(a: &BenchArgs) -> Result<()> {
+    let n = if a.quick { 512 } else { 2048 };
+    let raw = frames(n)?;
+    let mut results = Vec::new();
+    for threads in [1, 2] {
+        let bw = bandwidth::measure(threads, bandwidth::default_len(a.quick), a.reps)?;
+        let s = time_frames(threads, &raw, a.reps)?;
+        let fps = 1.0 / s;
+        let gbs = BYTES_PER_PX * (n * n) as f64 * fps / 1e9;
+        println!(
+            "radiograph {n}x{n} u16 -> REV g_S + eps_vol  threads={threads}  {fps:.1} frames/s (median of {})  \
+             {gbs:.2} GB/s moved = {:.2} of STREAM triad {:.1} GB/s",
+            a.reps,
+            gbs / bw.triad_gbs,
+            bw.triad_gbs
+        );
+        results.push(serde_json::json!({
+            "size": n, "threads": threads, "frames_per_s": fps, "gb_per_s": gbs,
+            "triad_gb_per_s": bw.triad_gbs, "ratio_to_triad": gbs / bw.triad_gbs,
+            "bytes_per_px": BYTES_PER_PX, "reps": a.reps,
+        }));
+    }
+    if let Some(p) = &a.json {
+        lbdem_core::atomic::write_atomic(p, &serde_json::to_vec_pretty(&results)?)?;
+    }
+    Ok(())
 }

@@ -1,9 +1,17 @@
 //! Plots every stage uses. Fields are `ndarray` views indexed `[row, col]` = `[y, x]`
 //! with row 0 at the top, as in an image.
+//!
+//! Text is drawn with DejaVu Sans embedded in the binary (plotters' `ab_glyph`), so a
+//! PNG is the same byte for byte on every machine. PNGs are encoded by `image` and
+//! written atomically.
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use ndarray::ArrayView2;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::{BlackWhite, ViridisRGB};
 use std::path::Path;
+use std::sync::Once;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Colormap {
@@ -55,28 +63,485 @@ pub struct Circle {
     pub class: usize,
 }
 
-/// PNG map of a field with a colour bar.
-pub fn field_png(_path: &Path, _field: ArrayView2<f64>, _opts: &FieldPlot) -> Result<()> {
-    bail!("plot::field_png is being written")
+/// Diverging blue-white-red map (Moreland's cool-warm end points), linear between stops.
+const COOL_WARM: [(f64, f64, f64); 5] = [
+    (59.0, 76.0, 192.0),
+    (144.0, 178.0, 254.0),
+    (221.0, 221.0, 221.0),
+    (245.0, 156.0, 125.0),
+    (180.0, 4.0, 38.0),
+];
+
+fn cool_warm(t: f64) -> RGBColor {
+    let x = t * (COOL_WARM.len() - 1) as f64;
+    let i = (x as usize).min(COOL_WARM.len() - 2);
+    let f = x - i as f64;
+    let (a, b) = (COOL_WARM[i], COOL_WARM[i + 1]);
+    let mix = |p: f64, q: f64| (p + f * (q - p)).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
-/// PNG x-y plot of one or more series.
-pub fn xy_png(_path: &Path, _series: &[Series], _opts: &XyPlot) -> Result<()> {
-    bail!("plot::xy_png is being written")
+const FONT: &str = "sans-serif";
+const MASKED: RGBColor = RGBColor(160, 160, 160);
+const SERIES_COLOURS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let bytes: &'static [u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+        for style in [FontStyle::Normal, FontStyle::Bold] {
+            // The font is embedded and known valid; a failure here is a build defect.
+            plotters::style::register_font(FONT, style, bytes)
+                .unwrap_or_else(|_| panic!("embedded DejaVuSans.ttf is not a valid font"));
+        }
+    });
+}
+
+fn colour(cmap: Colormap, t: f64) -> RGBColor {
+    let t = t.clamp(0.0, 1.0) as f32;
+    match cmap {
+        Colormap::Viridis => ViridisRGB::get_color(t),
+        Colormap::Diverging => cool_warm(t as f64),
+        Colormap::Gray => BlackWhite::get_color(t),
+    }
+}
+
+/// Render into an RGB buffer with `draw`, then PNG-encode and write atomically.
+fn render_png<F>(path: &Path, size: (u32, u32), background: Option<&[u8]>, draw: F) -> Result<()>
+where
+    F: FnOnce(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+{
+    register_font();
+    let mut buf = match background {
+        Some(bg) => bg.to_vec(),
+        None => vec![255u8; (size.0 * size.1 * 3) as usize],
+    };
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, size).into_drawing_area();
+        draw(&root)?;
+        root.present()
+            .map_err(|e| anyhow::anyhow!("plot drawing failed: {e}"))?;
+    }
+    let img = image::RgbImage::from_raw(size.0, size.1, buf).context("plot buffer has the wrong size")?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    lbdem_core::atomic::write_atomic(path, &png).with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn de<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow::anyhow!("plot drawing failed: {e}")
+}
+
+/// Finite min and max, or `None` when every value is NaN/inf.
+pub fn finite_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// The colour range a field map uses: given, or finite min/max (symmetric for Diverging),
+/// widened when flat so that the colour bar has a span.
+fn colour_range(field: &ArrayView2<f64>, opts: &FieldPlot) -> (f64, f64) {
+    let (mut lo, mut hi) = opts
+        .range
+        .or_else(|| finite_range(field.iter().copied()))
+        .unwrap_or((0.0, 1.0));
+    if opts.cmap == Colormap::Diverging && opts.range.is_none() {
+        let m = lo.abs().max(hi.abs());
+        (lo, hi) = (-m, m);
+    }
+    if hi <= lo {
+        let pad = if lo == 0.0 { 1e-12 } else { lo.abs() * 1e-6 };
+        (lo, hi) = (lo - pad, hi + pad);
+    }
+    (lo, hi)
+}
+
+/// PNG map of a field with a colour bar.
+pub fn field_png(path: &Path, field: ArrayView2<f64>, opts: &FieldPlot) -> Result<()> {
+    let (ny, nx) = field.dim();
+    if nx == 0 || ny == 0 {
+        bail!("cannot plot '{}': the field is empty ({nx} x {ny})", opts.title);
+    }
+    let (lo, hi) = colour_range(&field, opts);
+    let (scale, unit) = match opts.pixel_size {
+        Some(p) => (p * 1e3, "mm"),
+        None => (1.0, "px"),
+    };
+    let (w_data, h_data) = (nx as f64 * scale, ny as f64 * scale);
+    // Plot area about 640 px on its long side; the figure adds margins and the colour bar.
+    let long = 640.0;
+    let (pw, ph) = if nx >= ny {
+        (long, (long * ny as f64 / nx as f64).max(120.0))
+    } else {
+        ((long * nx as f64 / ny as f64).max(120.0), long)
+    };
+    let size = ((pw + 230.0) as u32, (ph + 110.0) as u32);
+    render_png(path, size, None, |root| {
+        root.fill(&WHITE).map_err(de)?;
+        let (left, right) = root.split_horizontally(size.0 - 140);
+        let mut chart = ChartBuilder::on(&left)
+            .caption(opts.title, (FONT, 20))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..w_data, 0.0..h_data)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc(format!("x ({unit})"))
+            .y_desc(format!("y ({unit})"))
+            .label_style((FONT, 13))
+            .draw()
+            .map_err(de)?;
+        let area = chart.plotting_area().strip_coord_spec();
+        let (aw, ah) = area.dim_in_pixel();
+        for py in 0..ah {
+            let row = ((py as f64 + 0.5) / ah as f64 * ny as f64) as usize;
+            for px in 0..aw {
+                let col = ((px as f64 + 0.5) / aw as f64 * nx as f64) as usize;
+                let v = field[[row.min(ny - 1), col.min(nx - 1)]];
+                let c = if v.is_finite() {
+                    colour(opts.cmap, (v - lo) / (hi - lo))
+                } else {
+                    MASKED
+                };
+                area.draw_pixel((px as i32, py as i32), &c).map_err(de)?;
+            }
+        }
+        colour_bar(&right, opts, lo, hi)
+    })
+}
+
+fn colour_bar(area: &DrawingArea<BitMapBackend, Shift>, opts: &FieldPlot, lo: f64, hi: f64) -> Result<()> {
+    let mut bar = ChartBuilder::on(area)
+        .margin_top(40)
+        .margin_bottom(50)
+        .margin_right(10)
+        .y_label_area_size(75)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(de)?;
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc(opts.label)
+        .label_style((FONT, 12))
+        .draw()
+        .map_err(de)?;
+    let n = 256;
+    bar.draw_series((0..n).map(|i| {
+        let (a, b) = (
+            lo + (hi - lo) * i as f64 / n as f64,
+            lo + (hi - lo) * (i + 1) as f64 / n as f64,
+        );
+        Rectangle::new(
+            [(0.0, a), (1.0, b)],
+            colour(opts.cmap, (i as f64 + 0.5) / n as f64).filled(),
+        )
+    }))
+    .map_err(de)?;
+    Ok(())
+}
+
+fn padded(lo: f64, hi: f64, log: bool) -> (f64, f64) {
+    if log {
+        return (lo / 1.3, hi * 1.3);
+    }
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else {
+        lo.abs().max(1.0) * 0.05
+    };
+    (lo - pad, hi + pad)
+}
+
+/// PNG x-y plot of one or more series (lines, or markers where `points`).
+pub fn xy_png(path: &Path, series: &[Series], opts: &XyPlot) -> Result<()> {
+    for s in series {
+        if s.x.len() != s.y.len() {
+            bail!(
+                "series '{}' has {} x values and {} y values",
+                s.label,
+                s.x.len(),
+                s.y.len()
+            );
+        }
+    }
+    let keep = |v: f64, log: bool| v.is_finite() && (!log || v > 0.0);
+    let xs = series
+        .iter()
+        .flat_map(|s| s.x.iter().copied())
+        .filter(|&v| keep(v, opts.log_x));
+    let ys = series
+        .iter()
+        .flat_map(|s| s.y.iter().copied())
+        .filter(|&v| keep(v, opts.log_y));
+    let (Some((x0, x1)), Some((y0, y1))) = (finite_range(xs), finite_range(ys)) else {
+        bail!("cannot plot '{}': no finite data points", opts.title);
+    };
+    let (x0, x1) = padded(x0, x1, opts.log_x);
+    let (y0, y1) = padded(y0, y1, opts.log_y);
+    render_png(path, (800, 560), None, |root| {
+        root.fill(&WHITE).map_err(de)?;
+        let mut b = ChartBuilder::on(root);
+        b.caption(opts.title, (FONT, 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70);
+        macro_rules! draw {
+            ($chart:expr) => {{
+                let mut chart = $chart.map_err(de)?;
+                chart
+                    .configure_mesh()
+                    .x_desc(opts.x_label)
+                    .y_desc(opts.y_label)
+                    .label_style((FONT, 13))
+                    .light_line_style(RGBColor(235, 235, 235))
+                    .draw()
+                    .map_err(de)?;
+                for (i, s) in series.iter().enumerate() {
+                    let c = SERIES_COLOURS[i % SERIES_COLOURS.len()];
+                    let pts: Vec<(f64, f64)> =
+                        s.x.iter()
+                            .zip(s.y)
+                            .map(|(&x, &y)| (x, y))
+                            .filter(|&(x, y)| keep(x, opts.log_x) && keep(y, opts.log_y))
+                            .collect();
+                    let anno = if s.points {
+                        chart.draw_series(
+                            pts.iter()
+                                .map(|&p| plotters::element::Circle::new(p, 3, c.filled())),
+                        )
+                    } else {
+                        chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                    }
+                    .map_err(de)?;
+                    if !s.label.is_empty() {
+                        anno.label(s.label).legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
+                        });
+                    }
+                }
+                if series.iter().any(|s| !s.label.is_empty()) {
+                    chart
+                        .configure_series_labels()
+                        .background_style(WHITE.mix(0.85))
+                        .border_style(BLACK)
+                        .label_font((FONT, 13))
+                        .draw()
+                        .map_err(de)?;
+                }
+            }};
+        }
+        match (opts.log_x, opts.log_y) {
+            (false, false) => draw!(b.build_cartesian_2d(x0..x1, y0..y1)),
+            (true, false) => draw!(b.build_cartesian_2d((x0..x1).log_scale(), y0..y1)),
+            (false, true) => draw!(b.build_cartesian_2d(x0..x1, (y0..y1).log_scale())),
+            (true, true) => draw!(b.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())),
+        }
+        Ok(())
+    })
+}
+
+/// Counts of `values` in `bins` equal bins over their finite range: (edges, counts).
+pub fn histogram(values: &[f64], bins: usize) -> Option<(Vec<f64>, Vec<usize>)> {
+    let (lo, hi) = finite_range(values.iter().copied())?;
+    let bins = bins.max(1);
+    let width = if hi > lo { (hi - lo) / bins as f64 } else { 1.0 };
+    let mut counts = vec![0usize; bins];
+    for &v in values.iter().filter(|v| v.is_finite()) {
+        counts[(((v - lo) / width) as usize).min(bins - 1)] += 1;
+    }
+    Some(((0..=bins).map(|i| lo + width * i as f64).collect(), counts))
 }
 
 /// PNG histogram.
-pub fn histogram_png(
-    _path: &Path,
-    _values: &[f64],
-    _bins: usize,
-    _title: &str,
-    _x_label: &str,
-) -> Result<()> {
-    bail!("plot::histogram_png is being written")
+pub fn histogram_png(path: &Path, values: &[f64], bins: usize, title: &str, x_label: &str) -> Result<()> {
+    let Some((edges, counts)) = histogram(values, bins) else {
+        bail!("cannot plot histogram '{title}': no finite values");
+    };
+    let top = *counts.iter().max().unwrap_or(&1) as f64 * 1.08;
+    render_png(path, (800, 520), None, |root| {
+        root.fill(&WHITE).map_err(de)?;
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(60)
+            .build_cartesian_2d(edges[0]..edges[edges.len() - 1], 0.0..top.max(1.0))
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc("count")
+            .label_style((FONT, 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(de)?;
+        chart
+            .draw_series(counts.iter().enumerate().map(|(i, &c)| {
+                Rectangle::new(
+                    [(edges[i], 0.0), (edges[i + 1], c as f64)],
+                    SERIES_COLOURS[0].mix(0.8).filled(),
+                )
+            }))
+            .map_err(de)?;
+        Ok(())
+    })
 }
 
-/// PNG of a grey image with circles drawn over it (same pixel size as the image).
-pub fn circles_overlay_png(_path: &Path, _image: ArrayView2<f64>, _circles: &[Circle]) -> Result<()> {
-    bail!("plot::circles_overlay_png is being written")
+/// PNG of a grey image (scaled to its finite min/max) with circles drawn over it, at the
+/// image's own pixel size so a person can check a fit by eye.
+pub fn circles_overlay_png(path: &Path, image: ArrayView2<f64>, circles: &[Circle]) -> Result<()> {
+    let (ny, nx) = image.dim();
+    if nx == 0 || ny == 0 {
+        bail!("cannot draw an overlay on an empty image");
+    }
+    let (lo, hi) = finite_range(image.iter().copied()).unwrap_or((0.0, 1.0));
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let mut bg = Vec::with_capacity(nx * ny * 3);
+    for v in image.iter() {
+        let g = if v.is_finite() {
+            (255.0 * (v - lo) / span).round() as u8
+        } else {
+            0
+        };
+        bg.extend([g, g, g]);
+    }
+    render_png(path, (nx as u32, ny as u32), Some(&bg), |root| {
+        for c in circles {
+            let colour = SERIES_COLOURS[(c.class + 1) % SERIES_COLOURS.len()];
+            root.draw(&plotters::element::Circle::new(
+                (c.x.round() as i32, c.y.round() as i32),
+                c.r.round().max(1.0) as i32,
+                colour.stroke_width(2),
+            ))
+            .map_err(de)?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ndarray::Array2;
+
+    fn png_size(p: &Path) -> (u32, u32) {
+        let img = image::open(p).unwrap();
+        (img.width(), img.height())
+    }
+
+    #[test]
+    fn field_map_is_written_and_masks_nan() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut f = Array2::from_shape_fn((50, 80), |(r, c)| (r as f64 - c as f64) / 50.0);
+        f[[0, 0]] = f64::NAN;
+        let p = dir.path().join("f.png");
+        let opts = FieldPlot {
+            title: "test",
+            label: "eps (-)",
+            cmap: Colormap::Diverging,
+            range: None,
+            pixel_size: Some(1e-5),
+        };
+        field_png(&p, f.view(), &opts).unwrap();
+        let (w, h) = png_size(&p);
+        assert!(w > 640 && h > 300, "unexpected figure size {w}x{h}");
+        // An all-NaN field still draws (all masked) instead of failing.
+        field_png(&p, Array2::from_elem((4, 4), f64::NAN).view(), &opts).unwrap();
+    }
+
+    #[test]
+    fn diverging_range_is_symmetric() {
+        let f = Array2::from_shape_vec((1, 2), vec![-0.01, 0.03]).unwrap();
+        let opts = FieldPlot {
+            title: "",
+            label: "",
+            cmap: Colormap::Diverging,
+            range: None,
+            pixel_size: None,
+        };
+        assert_eq!(colour_range(&f.view(), &opts), (-0.03, 0.03));
+        let opts = FieldPlot {
+            cmap: Colormap::Viridis,
+            ..opts
+        };
+        assert_eq!(colour_range(&f.view(), &opts), (-0.01, 0.03));
+    }
+
+    #[test]
+    fn xy_rejects_mismatched_series_and_draws_log_axes() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("xy.png");
+        let bad = [Series {
+            label: "a",
+            x: &[1.0, 2.0],
+            y: &[1.0],
+            points: false,
+        }];
+        assert!(xy_png(&p, &bad, &XyPlot::default()).is_err());
+        let x = [1.0, 10.0, 100.0];
+        let y = [1.0, 0.1, 0.01];
+        let s = [Series {
+            label: "decay",
+            x: &x,
+            y: &y,
+            points: true,
+        }];
+        xy_png(
+            &p,
+            &s,
+            &XyPlot {
+                title: "t",
+                x_label: "x",
+                y_label: "y",
+                log_x: true,
+                log_y: true,
+            },
+        )
+        .unwrap();
+        assert_eq!(png_size(&p), (800, 560));
+    }
+
+    #[test]
+    fn histogram_counts_every_finite_value() {
+        let v = [0.0, 0.1, 0.5, 0.9, 1.0, f64::NAN];
+        let (edges, counts) = histogram(&v, 2).unwrap();
+        assert_eq!(edges, vec![0.0, 0.5, 1.0]);
+        assert_eq!(counts, vec![2, 3]);
+        assert!(histogram(&[f64::NAN], 3).is_none());
+    }
+
+    #[test]
+    fn overlay_keeps_image_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("o.png");
+        let img = Array2::from_shape_fn((60, 90), |(r, c)| ((r * c) % 7) as f64);
+        circles_overlay_png(
+            &p,
+            img.view(),
+            &[Circle {
+                x: 30.0,
+                y: 20.0,
+                r: 8.0,
+                class: 0,
+            }],
+        )
+        .unwrap();
+        assert_eq!(png_size(&p), (90, 60));
+    }
 }

@@ -23,6 +23,8 @@ pub struct StageContext {
     pub base_dir: PathBuf,
     /// Output directories of earlier stages of the same pipeline, by stage name.
     pub earlier: Vec<(String, PathBuf)>,
+    /// The pipeline's output directory (None when the stage runs alone).
+    pub pipeline_out: Option<PathBuf>,
     progress: MultiProgress,
 }
 
@@ -33,8 +35,26 @@ impl StageContext {
             name,
             base_dir,
             earlier: Vec::new(),
+            pipeline_out: None,
             progress: MultiProgress::new(),
         }
+    }
+
+    /// The same context writing somewhere else (the runner's staging directory).
+    pub fn with_out_dir(&self, out_dir: PathBuf) -> Self {
+        Self {
+            out_dir,
+            name: self.name.clone(),
+            base_dir: self.base_dir.clone(),
+            earlier: self.earlier.clone(),
+            pipeline_out: self.pipeline_out.clone(),
+            progress: self.progress.clone(),
+        }
+    }
+
+    /// The pipeline's output directory, if the stage runs in a pipeline.
+    pub fn pipeline_dir(&self) -> Option<&Path> {
+        self.pipeline_out.as_deref()
     }
 
     /// A progress bar for multi-frame or multi-step work; drawn only on a terminal.
@@ -113,6 +133,22 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// A prepared stage from parts (the runner's own tests use this with a closure).
+    #[cfg(test)]
+    pub(crate) fn from_parts(
+        kind: &str,
+        params_json: serde_json::Value,
+        inputs: Vec<PathBuf>,
+        run: impl FnOnce(&StageContext) -> Result<StageOutput> + 'static,
+    ) -> Self {
+        Self {
+            kind: kind.into(),
+            params_json,
+            inputs,
+            run: Box::new(run),
+        }
+    }
+
     pub fn run(self, ctx: &StageContext) -> Result<StageOutput> {
         (self.run)(ctx)
     }

@@ -1,22 +1,768 @@
-//! Stage `radiograph` (work in progress on its issue branch).
+//! Stage `radiograph`: TIFF frames to thickness-corrected solid fraction, REV maps and
+//! volumetric strain (Su et al. 2020, Sect. 2.2, Eqs. 1-5), ROI profiles and the meniscus
+//! line scan (Eqs. 2, 22, 23). Frame 0 is the reference (undeformed) frame.
+//!
+//! Everything that can be wrong with the input (files, sizes, bit depths, ROIs, reference
+//! intensities, positivity, REV size, thickness) is checked before the first file is
+//! written; then frames are processed one by one and written.
 
-use super::{Stage, StageContext, StageOutput};
-use anyhow::{Result, bail};
+use super::{Figure, Stage, StageContext, StageOutput, Table};
+use crate::io::tiff as tio;
+use crate::report::{plot, table};
+use anyhow::{Context, Result, bail};
+use lbdem_imaging::beer_lambert::{self as bl, FractionMap};
+use lbdem_imaging::profile::{self, ProfileAxis};
+use lbdem_imaging::rev::{self, Sat};
+use lbdem_imaging::{Roi, correct};
+use ndarray::{Array2, s};
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use serde_json::json;
+use std::path::{Path, PathBuf};
 
-#[derive(Debug, Serialize, Deserialize)]
-pub struct Params {}
+/// How `L_alloy^n` of frame n is found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Thickness {
+    /// `L^n = L^0` (no correction: only for a sample whose thickness cannot change).
+    #[default]
+    None,
+    /// Eq. (2) over `thickness_roi`, a negligibly deformed or fully liquid region
+    /// (`L_S.min^n = L_S.min^0`).
+    Eq2,
+    /// Eq. (3) over `thickness_roi`, a region of nearly 100% solid.
+    Eq3,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gamma {
+    /// Median window side (odd, px).
+    #[serde(default = "three")]
+    pub size: usize,
+    /// Outlier threshold in robust standard deviations.
+    #[serde(default = "six")]
+    pub threshold: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProfileSpec {
+    pub name: String,
+    /// `[x, y, w, h]` in pixels.
+    pub roi: Roi,
+    pub axis: ProfileAxis,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineScan {
+    /// Column of the vertical line (px) and its row range `y0..y1` (Fig. 12f).
+    pub x: usize,
+    pub y0: usize,
+    pub y1: usize,
+    /// Half-width (m) of the window around the thinnest point fitted by a parabola;
+    /// 0 skips the meniscus fit.
+    #[serde(default)]
+    pub fit_half_width: f64,
+    /// Liquid-air interfacial energy, J/m^2 (Su et al. 2020 take 0.7 for Al-Cu, ref. [123]).
+    #[serde(default = "gamma_alcu")]
+    pub gamma: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Params {
+    /// Frame files, multi-page stacks or directories of numbered frames; the first frame is
+    /// the reference (n = 0).
+    pub frames: Vec<PathBuf>,
+    /// Dark-current frame (a stack is averaged).
+    #[serde(default)]
+    pub dark: Option<PathBuf>,
+    /// Open-beam (flat-field) frame (a stack is averaged).
+    #[serde(default)]
+    pub flat: Option<PathBuf>,
+    /// Gamma-spot removal, applied to frames, dark and flat before correction.
+    #[serde(default)]
+    pub gamma_spots: Option<Gamma>,
+    /// Open-beam region for dose normalisation of every frame (`[x, y, w, h]`, px).
+    #[serde(default)]
+    pub open_roi: Option<Roi>,
+    /// Treat pixels that are not positive after correction as masked instead of failing.
+    #[serde(default)]
+    pub mask_nonpositive: bool,
+    /// `I_L^0`, through 100% liquid: a value (corrected intensity units) or an ROI of frame 0.
+    #[serde(default)]
+    pub i_l0: Option<f64>,
+    #[serde(default)]
+    pub i_l0_roi: Option<Roi>,
+    /// `I_S^0`, through 100% solid: a value or an ROI of frame 0.
+    #[serde(default)]
+    pub i_s0: Option<f64>,
+    #[serde(default)]
+    pub i_s0_roi: Option<Roi>,
+    /// Linear attenuation coefficients of solid and liquid, 1/m.
+    pub mu_s: f64,
+    pub mu_l: f64,
+    /// Initial sample thickness `L_alloy^0`, m.
+    pub l_alloy0: f64,
+    #[serde(default)]
+    pub thickness: Thickness,
+    #[serde(default)]
+    pub thickness_roi: Option<Roi>,
+    /// Mean grain size `d_bar` and pixel size, m.
+    pub d_bar: f64,
+    pub pixel_size: f64,
+    /// REV side = `rev_factor * d_bar` (Su et al. 2020: sqrt(10)).
+    #[serde(default = "sqrt10")]
+    pub rev_factor: f64,
+    /// A REV with fewer finite pixels than this fraction of a full window is NaN.
+    #[serde(default = "half")]
+    pub min_valid: f64,
+    /// eps_vol (Eq. 5) is NaN where the reference REV holds less solid than this (liquid:
+    /// the ratio g^0/g^n of two near-zero fractions means nothing).
+    #[serde(default = "eps_min_gs")]
+    pub eps_min_gs: f64,
+    /// Area of the global `g_S` average (Eq. 1b); the whole image by default.
+    #[serde(default)]
+    pub global_area: Option<Roi>,
+    #[serde(default)]
+    pub profiles: Vec<ProfileSpec>,
+    #[serde(default)]
+    pub line_scan: Option<LineScan>,
+    /// PNG maps and plots (off for batch runs that only need the fields).
+    #[serde(default = "yes")]
+    pub plots: bool,
+    /// Also write per-pixel fields (corrected intensity, pixel `L_S/L`).
+    #[serde(default)]
+    pub write_pixel_maps: bool,
+}
+
+fn three() -> usize {
+    3
+}
+fn six() -> f64 {
+    6.0
+}
+fn gamma_alcu() -> f64 {
+    0.7
+}
+fn sqrt10() -> f64 {
+    10f64.sqrt()
+}
+fn eps_min_gs() -> f64 {
+    0.1
+}
+fn half() -> f64 {
+    0.5
+}
+fn yes() -> bool {
+    true
+}
 
 pub struct Radiograph;
 
 impl Stage for Radiograph {
     const KIND: &'static str = "radiograph";
     type Params = Params;
-    fn inputs(_: &Params, _: &StageContext) -> Vec<PathBuf> {
-        Vec::new()
+    fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
+        let frames: Vec<PathBuf> = p.frames.iter().map(|f| ctx.resolve(f)).collect();
+        let mut v = tio::expand_paths(&frames).unwrap_or(frames);
+        v.extend(p.dark.iter().chain(&p.flat).map(|f| ctx.resolve(f)));
+        v
     }
-    fn run(_: &Params, _: &StageContext) -> Result<StageOutput> {
-        bail!("stage 'radiograph' is not built yet")
+    fn run(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
+        let prepared = prepare(p, ctx)?;
+        write_outputs(p, ctx, &prepared)
     }
+}
+
+/// Everything validated and corrected, ready to process and write.
+pub struct Prepared {
+    pub labels: Vec<String>,
+    /// Corrected intensities (NaN = masked).
+    pub intensity: Vec<Array2<f64>>,
+    pub rev_side: usize,
+    pub i_l0: f64,
+    pub i_s0: f64,
+    /// `L_alloy^n` of every frame, m.
+    pub thickness: Vec<f64>,
+    pub maps: Vec<FractionMap>,
+    pub gamma_replaced: Vec<usize>,
+    pub dose: Vec<f64>,
+    pub masked: Vec<usize>,
+    pub warnings: Vec<String>,
+}
+
+fn positive(name: &str, v: f64) -> Result<()> {
+    if !(v > 0.0 && v.is_finite()) {
+        bail!("parameter '{name}' = {v} must be positive and finite (SI units)");
+    }
+    Ok(())
+}
+
+fn one_of(name: &str, value: Option<f64>, roi: Option<Roi>) -> Result<()> {
+    match (value, roi) {
+        (Some(_), None) | (None, Some(_)) => Ok(()),
+        _ => bail!(
+            "give exactly one of '{name}' (a value) and '{name}_roi' (a rectangle [x, y, w, h] of frame 0)"
+        ),
+    }
+}
+
+/// Read, validate and correct every input; no file is written here.
+pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
+    for (n, v) in [
+        ("mu_s", p.mu_s),
+        ("mu_l", p.mu_l),
+        ("l_alloy0", p.l_alloy0),
+        ("d_bar", p.d_bar),
+        ("pixel_size", p.pixel_size),
+        ("rev_factor", p.rev_factor),
+    ] {
+        positive(n, v)?;
+    }
+    if !(p.min_valid > 0.0 && p.min_valid <= 1.0) {
+        bail!("parameter 'min_valid' = {} must be in (0, 1]", p.min_valid);
+    }
+    if p.mu_s == p.mu_l {
+        bail!(
+            "parameters 'mu_s' and 'mu_l' are both {}: with no contrast no solid fraction can be measured",
+            p.mu_s
+        );
+    }
+    if p.frames.is_empty() {
+        bail!("parameter 'frames' is empty: list at least one TIFF file, stack or directory");
+    }
+    one_of("i_l0", p.i_l0, p.i_l0_roi)?;
+    one_of("i_s0", p.i_s0, p.i_s0_roi)?;
+    if p.thickness != Thickness::None && p.thickness_roi.is_none() {
+        bail!(
+            "thickness = \"{:?}\" needs 'thickness_roi' = [x, y, w, h]",
+            p.thickness
+        );
+    }
+
+    let paths: Vec<PathBuf> = p.frames.iter().map(|f| ctx.resolve(f)).collect();
+    let frames = tio::read_frames(&paths)?;
+    let shape = frames[0].data.dim();
+    for f in &frames[1..] {
+        if f.data.dim() != shape {
+            bail!(
+                "frame {} is {}x{} (rows x cols) but the first frame {} is {}x{}; all frames must have one size",
+                f.label,
+                f.data.nrows(),
+                f.data.ncols(),
+                frames[0].label,
+                shape.0,
+                shape.1
+            );
+        }
+    }
+    let read_ref = |o: &Option<PathBuf>, what: &str| -> Result<Option<Array2<f64>>> {
+        let Some(path) = o else { return Ok(None) };
+        let f = tio::read_mean(&ctx.resolve(path)).with_context(|| format!("parameter '{what}'"))?;
+        if f.data.dim() != shape {
+            bail!(
+                "{what} field {} is {}x{} but the frames are {}x{}",
+                f.label,
+                f.data.nrows(),
+                f.data.ncols(),
+                shape.0,
+                shape.1
+            );
+        }
+        Ok(Some(f.data))
+    };
+    let mut dark = read_ref(&p.dark, "dark")?;
+    let mut flat = read_ref(&p.flat, "flat")?;
+
+    let rev_side = rev::rev_side_px(p.rev_factor, p.d_bar, p.pixel_size)?;
+    if rev_side > shape.0 || rev_side > shape.1 {
+        bail!(
+            "REV side {rev_side} px (rev_factor {} x d_bar {} m / pixel_size {} m) is larger than the {}x{} image; \
+             lower d_bar or rev_factor, or use a larger field of view",
+            p.rev_factor,
+            p.d_bar,
+            p.pixel_size,
+            shape.1,
+            shape.0
+        );
+    }
+    let mut rois: Vec<(&str, Roi)> = Vec::new();
+    rois.extend(p.open_roi.map(|r| ("open_roi", r)));
+    rois.extend(p.i_l0_roi.map(|r| ("i_l0_roi", r)));
+    rois.extend(p.i_s0_roi.map(|r| ("i_s0_roi", r)));
+    rois.extend(p.thickness_roi.map(|r| ("thickness_roi", r)));
+    rois.extend(p.global_area.map(|r| ("global_area", r)));
+    for pr in &p.profiles {
+        rois.push(("profiles.roi", pr.roi));
+    }
+    for (name, r) in &rois {
+        r.check(name, shape)
+            .map_err(|e| anyhow::anyhow!("parameter '{name}': {e}"))?;
+    }
+    if let Some(ls) = &p.line_scan {
+        if ls.x >= shape.1 || ls.y0 + 3 > ls.y1 || ls.y1 > shape.0 {
+            bail!(
+                "line_scan x = {}, y0 = {}, y1 = {} is outside the {}x{} image or shorter than 3 px; \
+                 need x < {} and y0 + 3 <= y1 <= {}",
+                ls.x,
+                ls.y0,
+                ls.y1,
+                shape.1,
+                shape.0,
+                shape.1,
+                shape.0
+            );
+        }
+        if ls.fit_half_width < 0.0 || !ls.gamma.is_finite() {
+            bail!("line_scan.fit_half_width must be >= 0 m and line_scan.gamma finite (J/m^2)");
+        }
+    }
+
+    // Corrections.
+    let mut gamma_replaced = Vec::new();
+    if let Some(g) = &p.gamma_spots {
+        for f in [&mut dark, &mut flat].into_iter().flatten() {
+            *f = correct::remove_gamma_spots(f.view(), g.size, g.threshold)?.0;
+        }
+    }
+    let mut labels = Vec::new();
+    let mut intensity = Vec::new();
+    let (mut dose, mut masked) = (Vec::new(), Vec::new());
+    for f in frames {
+        let mut raw = f.data;
+        let mut n_g = 0;
+        if let Some(g) = &p.gamma_spots {
+            (raw, n_g) = correct::remove_gamma_spots(raw.view(), g.size, g.threshold)?;
+        }
+        let mut i = correct::flat_dark(
+            raw.view(),
+            dark.as_ref().map(|d| d.view()),
+            flat.as_ref().map(|d| d.view()),
+        );
+        let d = match p.open_roi {
+            Some(r) => correct::dose_normalise(&mut i, r).with_context(|| format!("frame {}", f.label))?,
+            None => 1.0,
+        };
+        let n_masked = correct::check_positive(&mut i, &format!("frame {}", f.label), p.mask_nonpositive)?;
+        gamma_replaced.push(n_g);
+        dose.push(d);
+        masked.push(n_masked);
+        labels.push(f.label);
+        intensity.push(i);
+    }
+
+    // Reference intensities and Eq. (1a).
+    let i0 = &intensity[0];
+    let i_l0 = match (p.i_l0, p.i_l0_roi) {
+        (Some(v), _) => v,
+        (_, Some(r)) => r.mean("i_l0_roi", i0.view())?,
+        _ => unreachable!("checked by one_of"),
+    };
+    let i_s0 = match (p.i_s0, p.i_s0_roi) {
+        (Some(v), _) => v,
+        (_, Some(r)) => r.mean("i_s0_roi", i0.view())?,
+        _ => unreachable!("checked by one_of"),
+    };
+    let map0 = FractionMap::eq1(i_l0, i_s0).map_err(|e| anyhow::anyhow!("parameters 'i_l0'/'i_s0': {e}"))?;
+    let mut warnings = Vec::new();
+    let dmu_ref = (i_s0.ln() - i_l0.ln()) / p.l_alloy0;
+    let dmu = p.mu_l - p.mu_s;
+    if ((dmu_ref - dmu) / dmu).abs() > 0.1 {
+        warnings.push(format!(
+            "the reference intensities give mu_L - mu_S = (ln I_S^0 - ln I_L^0) / L^0 = {dmu_ref:.4e} 1/m but \
+             mu_l - mu_s = {dmu:.4e} 1/m: frame 0 (Eq. 1a) and later frames (Eq. 4b) disagree in scale, so \
+             eps_vol is biased; check mu_s, mu_l, l_alloy0 and the reference ROIs"
+        ));
+    }
+
+    // Thickness of every frame and its Eq. (4) map.
+    let mut thickness = vec![p.l_alloy0];
+    let mut maps = vec![map0];
+    let troi0 = match (p.thickness, p.thickness_roi) {
+        (Thickness::None, _) | (_, None) => f64::NAN,
+        (_, Some(r)) => r.mean("thickness_roi", i0.view())?,
+    };
+    for (n, i) in intensity.iter().enumerate().skip(1) {
+        let l = match (p.thickness, p.thickness_roi) {
+            (Thickness::None, _) | (_, None) => p.l_alloy0,
+            (Thickness::Eq2, Some(r)) => {
+                let m = r.mean("thickness_roi", i.view())?;
+                bl::thickness_eq2(p.l_alloy0, p.mu_s, p.mu_l, troi0, m, 0.0, 0.0)
+            }
+            (Thickness::Eq3, Some(r)) => {
+                let m = r.mean("thickness_roi", i.view())?;
+                bl::thickness_eq3(p.l_alloy0, p.mu_s, troi0, m)
+            }
+        };
+        if !(l > 0.0 && l.is_finite()) {
+            bail!(
+                "frame {}: thickness L_alloy^{n} = {l} m from {:?} over thickness_roi is not positive; \
+                 check thickness_roi (fully liquid for eq2, fully solid for eq3) and mu_s/mu_l",
+                labels[n],
+                p.thickness
+            );
+        }
+        thickness.push(l);
+        maps.push(
+            FractionMap::eq4(i_l0, p.mu_s, p.mu_l, p.l_alloy0, l)
+                .map_err(|e| anyhow::anyhow!("frame {}: {e}", labels[n]))?,
+        );
+    }
+    Ok(Prepared {
+        labels,
+        intensity,
+        rev_side,
+        i_l0,
+        i_s0,
+        thickness,
+        maps,
+        gamma_replaced,
+        dose,
+        masked,
+        warnings,
+    })
+}
+
+/// Mean of the finite values.
+fn finite_mean(a: &Array2<f64>) -> f64 {
+    let (s, n) = a
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 { f64::NAN } else { s / n as f64 }
+}
+
+/// One profile of one frame: positions (px), REV g_S, and eps_vol (frames n >= 1).
+type ProfileOut = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
+
+/// Per-frame results kept for the tables.
+struct FrameOut {
+    gs_tiles: Array2<f64>,
+    eps_tiles: Option<Array2<f64>>,
+    profiles: Vec<ProfileOut>,
+}
+
+fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageOutput> {
+    let out = &ctx.out_dir;
+    let mut files: Vec<PathBuf> = Vec::new();
+    let mut figures = Vec::new();
+    let mut tables = Vec::new();
+    let nf = pr.intensity.len();
+    let shape = pr.intensity[0].dim();
+    let area = p.global_area.unwrap_or(Roi::new(0, 0, shape.1, shape.0));
+    let png_frame = |n: usize| p.plots && (nf <= 8 || n == 0 || n + 1 == nf);
+    let mm = |px: f64| px * p.pixel_size * 1e3;
+
+    let pb = ctx.progress_bar(nf as u64, "radiograph");
+    let mut sat = Sat::new();
+    let mut g0_rev = Array2::zeros(shape);
+    let mut g_rev = Array2::zeros(shape);
+    let mut frames_json = Vec::new();
+    let mut outs = Vec::new();
+    for n in 0..nf {
+        let gpix = pr.maps[n].field(pr.intensity[n].view());
+        sat.build(gpix.view());
+        let global = sat.area_mean(area)?;
+        let target = if n == 0 { &mut g0_rev } else { &mut g_rev };
+        sat.rev_mean_into(pr.rev_side, p.min_valid, target)?;
+        let gs_tiles = sat.tiles(pr.rev_side, p.min_valid)?;
+        let gname = format!("gs_rev_{n:03}");
+        let gmap = if n == 0 { &g0_rev } else { &g_rev };
+        tio::write_f32(&out.join(format!("{gname}.tif")), gmap.view())?;
+        files.push(format!("{gname}.tif").into());
+        if p.write_pixel_maps {
+            for (name, f) in [("intensity", &pr.intensity[n]), ("gs_pixel", &gpix)] {
+                let fname = format!("{name}_{n:03}.tif");
+                tio::write_f32(&out.join(&fname), f.view())?;
+                files.push(fname.into());
+            }
+        }
+        let mut eps_json = serde_json::Value::Null;
+        let mut eps_tiles = None;
+        let eps = (n > 0).then(|| bl::eps_vol_field(g0_rev.view(), g_rev.view(), p.eps_min_gs));
+        if let Some(eps) = &eps {
+            let ename = format!("eps_vol_{n:03}");
+            tio::write_f32(&out.join(format!("{ename}.tif")), eps.view())?;
+            files.push(format!("{ename}.tif").into());
+            eps_json = json!(finite_mean(eps));
+            let g0t = outs
+                .first()
+                .map(|o: &FrameOut| o.gs_tiles.clone())
+                .unwrap_or_default();
+            eps_tiles = Some(bl::eps_vol_field(g0t.view(), gs_tiles.view(), p.eps_min_gs));
+            if png_frame(n) {
+                let f = format!("{ename}.png");
+                plot::field_png(
+                    &out.join(&f),
+                    eps.view(),
+                    &plot::FieldPlot {
+                        title: &format!("eps_vol, frame {n} (Eq. 5)"),
+                        label: "eps_vol (-)",
+                        cmap: plot::Colormap::Diverging,
+                        range: None,
+                        pixel_size: Some(p.pixel_size),
+                    },
+                )?;
+                figures.push(Figure {
+                    path: f.clone().into(),
+                    caption: format!(
+                        "Volumetric strain eps_vol = g_S.REV^0 / g_S.REV^{n} - 1 (Eq. 5) of frame {n} ({}); \
+                         positive = dilation. REV {} px.",
+                        pr.labels[n], pr.rev_side
+                    ),
+                });
+                files.push(f.into());
+            }
+        }
+        if png_frame(n) {
+            let f = format!("{gname}.png");
+            plot::field_png(
+                &out.join(&f),
+                gmap.view(),
+                &plot::FieldPlot {
+                    title: &format!("g_S.REV, frame {n}"),
+                    label: "g_S (-)",
+                    cmap: plot::Colormap::Viridis,
+                    range: None,
+                    pixel_size: Some(p.pixel_size),
+                },
+            )?;
+            figures.push(Figure {
+                path: f.clone().into(),
+                caption: format!(
+                    "REV-averaged solid fraction g_S.REV of frame {n} ({}), Eq. ({}), REV side {} px = {:.3} x d_bar.",
+                    pr.labels[n],
+                    if n == 0 { "1" } else { "4b" },
+                    pr.rev_side,
+                    p.rev_factor
+                ),
+            });
+            files.push(f.into());
+        }
+        let mut profs = Vec::new();
+        for spec in &p.profiles {
+            let (pos, g) = profile::roi_profile(gmap.view(), spec.roi, spec.axis, "profiles.roi")?;
+            let e = match &eps {
+                Some(e) => Some(profile::roi_profile(e.view(), spec.roi, spec.axis, "profiles.roi")?.1),
+                None => None,
+            };
+            profs.push((pos, g, e));
+        }
+        frames_json.push(json!({
+            "frame": n,
+            "label": pr.labels[n],
+            "thickness_m": pr.thickness[n],
+            "i_l_n": pr.i_l0 * (-p.mu_l * (pr.thickness[n] - p.l_alloy0)).exp(),
+            "g_s_global": global,
+            "g_s_rev_mean": finite_mean(gmap),
+            "eps_vol_mean": eps_json,
+            "dose_divisor": pr.dose[n],
+            "gamma_spots_replaced": pr.gamma_replaced[n],
+            "masked_pixels": pr.masked[n],
+        }));
+        outs.push(FrameOut {
+            gs_tiles,
+            eps_tiles,
+            profiles: profs,
+        });
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+
+    // Tiled grid: one row per tile.
+    let (th, tw) = outs[0].gs_tiles.dim();
+    let side = pr.rev_side as f64;
+    let mut cols: Vec<(String, Vec<f64>)> = vec![
+        (
+            "x_mm".into(),
+            (0..th * tw).map(|k| mm(((k % tw) as f64 + 0.5) * side)).collect(),
+        ),
+        (
+            "y_mm".into(),
+            (0..th * tw).map(|k| mm(((k / tw) as f64 + 0.5) * side)).collect(),
+        ),
+    ];
+    for (n, o) in outs.iter().enumerate() {
+        cols.push((format!("g_s_{n:03}"), o.gs_tiles.iter().copied().collect()));
+        if let Some(e) = &o.eps_tiles {
+            cols.push((format!("eps_vol_{n:03}"), e.iter().copied().collect()));
+        }
+    }
+    write_table(out, "grid.csv", &cols)?;
+    files.push("grid.csv".into());
+    tables.push(Table {
+        path: "grid.csv".into(),
+        caption: format!(
+            "Tiled REV grid ({th} x {tw} tiles of {} px): tile centres (mm), g_S of every frame and eps_vol (Eq. 5).",
+            pr.rev_side
+        ),
+    });
+
+    // Profiles.
+    for (k, spec) in p.profiles.iter().enumerate() {
+        let pos: Vec<f64> = outs[0].profiles[k].0.iter().map(|&x| mm(x)).collect();
+        let axis = match spec.axis {
+            ProfileAxis::X => "x",
+            ProfileAxis::Y => "y",
+        };
+        let mut cols: Vec<(String, Vec<f64>)> = vec![(format!("{axis}_mm"), pos.clone())];
+        for (n, o) in outs.iter().enumerate() {
+            cols.push((format!("g_s_{n:03}"), o.profiles[k].1.clone()));
+            if let Some(e) = &o.profiles[k].2 {
+                cols.push((format!("eps_vol_{n:03}"), e.clone()));
+            }
+        }
+        let name = format!("profile_{}.csv", spec.name);
+        write_table(out, &name, &cols)?;
+        files.push(name.clone().into());
+        tables.push(Table {
+            path: name.into(),
+            caption: format!(
+                "Profile '{}' along {axis} over ROI {:?} (px): REV g_S and eps_vol averaged across the ROI.",
+                spec.name,
+                <[usize; 4]>::from(spec.roi)
+            ),
+        });
+        if p.plots {
+            for (what, label) in [("g_s", "g_S (-)"), ("eps_vol", "eps_vol (-)")] {
+                let series: Vec<(String, Vec<f64>)> = cols
+                    .iter()
+                    .skip(1)
+                    .filter(|(c, _)| c.starts_with(what))
+                    .map(|(c, v)| (format!("frame {}", &c[c.len() - 3..]), v.clone()))
+                    .collect();
+                if series.is_empty() {
+                    continue;
+                }
+                let s: Vec<plot::Series> = series
+                    .iter()
+                    .map(|(l, v)| plot::Series {
+                        label: l,
+                        x: &pos,
+                        y: v,
+                        points: false,
+                    })
+                    .collect();
+                let f = format!("profile_{}_{what}.png", spec.name);
+                plot::xy_png(
+                    &out.join(&f),
+                    &s,
+                    &plot::XyPlot {
+                        title: &format!("{what} profile '{}'", spec.name),
+                        x_label: &format!("{axis} (mm)"),
+                        y_label: label,
+                        ..Default::default()
+                    },
+                )?;
+                figures.push(Figure {
+                    path: f.clone().into(),
+                    caption: format!(
+                        "{label} along {axis} in profile ROI '{}', every frame.",
+                        spec.name
+                    ),
+                });
+                files.push(f.into());
+            }
+        }
+    }
+
+    // Line scan and meniscus (Eqs. 2, 22, 23).
+    let mut meniscus = Vec::new();
+    if let Some(ls) = &p.line_scan {
+        let y: Vec<f64> = (ls.y0..ls.y1).map(|r| (r as f64 + 0.5) * p.pixel_size).collect();
+        let mut cols: Vec<(String, Vec<f64>)> = vec![("y_mm".into(), y.iter().map(|v| v * 1e3).collect())];
+        let line0 = pr.intensity[0].slice(s![ls.y0..ls.y1, ls.x..ls.x + 1]).to_owned();
+        let mut series = Vec::new();
+        for n in 0..nf {
+            let line = pr.intensity[n].slice(s![ls.y0..ls.y1, ls.x..ls.x + 1]).to_owned();
+            let l = bl::thickness_field_eq2(p.l_alloy0, p.mu_l, line0.view(), line.view());
+            let l: Vec<f64> = l.iter().copied().collect();
+            if n > 0 && ls.fit_half_width > 0.0 {
+                match profile::meniscus_fit(&y, &l, ls.fit_half_width, ls.gamma) {
+                    Ok(m) => meniscus.push(json!({"frame": n, "fit": m})),
+                    Err(e) => meniscus.push(json!({"frame": n, "error": e.to_string()})),
+                }
+            }
+            cols.push((format!("z_top_um_{n:03}"), l.iter().map(|v| 0.5e6 * v).collect()));
+            cols.push((format!("l_alloy_um_{n:03}"), l.iter().map(|v| 1e6 * v).collect()));
+            series.push((
+                format!("frame {n}"),
+                l.iter().map(|v| 0.5e6 * v).collect::<Vec<f64>>(),
+            ));
+        }
+        write_table(out, "line_scan.csv", &cols)?;
+        files.push("line_scan.csv".into());
+        tables.push(Table {
+            path: "line_scan.csv".into(),
+            caption: format!(
+                "Line scan at x = {} px, y = {}..{} px: thickness L_alloy^n (Eq. 2 per pixel) and surface z = L/2 (Eq. 22).",
+                ls.x, ls.y0, ls.y1
+            ),
+        });
+        if p.plots {
+            let ymm: Vec<f64> = y.iter().map(|v| v * 1e3).collect();
+            let s: Vec<plot::Series> = series
+                .iter()
+                .map(|(l, v)| plot::Series {
+                    label: l,
+                    x: &ymm,
+                    y: v,
+                    points: false,
+                })
+                .collect();
+            plot::xy_png(
+                &out.join("line_scan.png"),
+                &s,
+                &plot::XyPlot {
+                    title: "Meniscus line scan, z = L_alloy/2 (Eq. 22)",
+                    x_label: "y (mm)",
+                    y_label: "z (um)",
+                    ..Default::default()
+                },
+            )?;
+            figures.push(Figure {
+                path: "line_scan.png".into(),
+                caption: "Sample surface z = L_alloy^n / 2 along the line scan (Eqs. 2, 22), every frame (cf. Fig. 12h)."
+                    .into(),
+            });
+            files.push("line_scan.png".into());
+        }
+    }
+
+    for w in &pr.warnings {
+        eprintln!("radiograph: warning: {w}");
+    }
+    let summary = json!({
+        "frames": nf,
+        "image_rows": shape.0,
+        "image_cols": shape.1,
+        "rev_side_px": pr.rev_side,
+        "rev_side_m": pr.rev_side as f64 * p.pixel_size,
+        "i_l0": pr.i_l0,
+        "i_s0": pr.i_s0,
+        "mu_s": p.mu_s,
+        "mu_l": p.mu_l,
+        "l_alloy0_m": p.l_alloy0,
+        "thickness_method": p.thickness,
+        "global_area": p.global_area.unwrap_or(area),
+        "per_frame": frames_json,
+        "meniscus": meniscus,
+        "warnings": pr.warnings,
+    });
+    lbdem_core::atomic::write_atomic(&out.join("summary.json"), &serde_json::to_vec_pretty(&summary)?)
+        .with_context(|| format!("cannot write {}", out.join("summary.json").display()))?;
+    files.push("summary.json".into());
+    Ok(StageOutput {
+        summary,
+        figures,
+        tables,
+        files,
+    })
+}
+
+fn write_table(dir: &Path, name: &str, cols: &[(String, Vec<f64>)]) -> Result<()> {
+    let c: Vec<(&str, &[f64])> = cols.iter().map(|(n, v)| (n.as_str(), v.as_slice())).collect();
+    table::write_csv(&dir.join(name), &c)
 }

@@ -1,0 +1,136 @@
+//! The runner's contracts: outputs appear only on success, unchanged stages are skipped,
+//! any change to inputs, parameters or outputs reruns them.
+
+use super::*;
+use crate::stages::{Prepared, StageContext, StageOutput};
+use std::path::PathBuf;
+
+fn writer_stage(input: PathBuf, param: i64, fail: bool) -> Prepared {
+    Prepared::from_parts(
+        "test",
+        serde_json::json!({ "p": param }),
+        vec![input],
+        move |ctx: &StageContext| {
+            lbdem_core::atomic::write_atomic(&ctx.out_dir.join("a.txt"), b"payload")?;
+            if fail {
+                anyhow::bail!("parameter p = {param} is invalid");
+            }
+            Ok(StageOutput {
+                files: vec!["a.txt".into()],
+                ..Default::default()
+            })
+        },
+    )
+}
+
+fn setup() -> (tempfile::TempDir, PathBuf, StageContext) {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.dat");
+    std::fs::write(&input, b"input bytes").unwrap();
+    let ctx = StageContext::new(dir.path().join("out/stage"), "s".into(), dir.path().into());
+    (dir, input, ctx)
+}
+
+#[test]
+fn success_publishes_outputs_and_manifest() {
+    let (_d, input, ctx) = setup();
+    let rec = execute(writer_stage(input.clone(), 1, false), &ctx).unwrap();
+    assert_eq!(std::fs::read(ctx.out_dir.join("a.txt")).unwrap(), b"payload");
+    assert!(ctx.out_dir.join(MANIFEST).is_file());
+    assert_eq!(rec.inputs.len(), 1);
+    assert_eq!(rec.inputs[0].bytes, 11);
+    // No staging directory is left behind.
+    let left: Vec<_> = std::fs::read_dir(&ctx.out_dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "unexpected files: {left:?}");
+}
+
+#[test]
+fn failure_writes_nothing() {
+    let (_d, input, ctx) = setup();
+    let err = execute(writer_stage(input, 7, true), &ctx).unwrap_err();
+    assert!(format!("{err:#}").contains("p = 7"), "{err:#}");
+    assert!(
+        !ctx.out_dir.exists(),
+        "a failed stage left {}",
+        ctx.out_dir.display()
+    );
+}
+
+#[test]
+fn failure_keeps_earlier_good_outputs() {
+    let (_d, input, ctx) = setup();
+    execute(writer_stage(input.clone(), 1, false), &ctx).unwrap();
+    assert!(execute(writer_stage(input, 2, true), &ctx).is_err());
+    assert_eq!(std::fs::read(ctx.out_dir.join("a.txt")).unwrap(), b"payload");
+    let rec: StageRecord =
+        serde_json::from_slice(&std::fs::read(ctx.out_dir.join(MANIFEST)).unwrap()).unwrap();
+    assert_eq!(rec.params["p"], 1);
+}
+
+#[test]
+fn cache_hits_only_when_nothing_changed() {
+    let (_d, input, ctx) = setup();
+    assert!(
+        cache::reusable(&writer_stage(input.clone(), 1, false), &ctx)
+            .unwrap()
+            .is_none()
+    );
+    execute(writer_stage(input.clone(), 1, false), &ctx).unwrap();
+    assert!(
+        cache::reusable(&writer_stage(input.clone(), 1, false), &ctx)
+            .unwrap()
+            .is_some()
+    );
+    // A parameter change misses.
+    assert!(
+        cache::reusable(&writer_stage(input.clone(), 2, false), &ctx)
+            .unwrap()
+            .is_none()
+    );
+    // An input byte change misses.
+    std::fs::write(&input, b"input bytez").unwrap();
+    assert!(
+        cache::reusable(&writer_stage(input.clone(), 1, false), &ctx)
+            .unwrap()
+            .is_none()
+    );
+    std::fs::write(&input, b"input bytes").unwrap();
+    assert!(
+        cache::reusable(&writer_stage(input.clone(), 1, false), &ctx)
+            .unwrap()
+            .is_some()
+    );
+    // A deleted output misses.
+    std::fs::remove_file(ctx.out_dir.join("a.txt")).unwrap();
+    assert!(
+        cache::reusable(&writer_stage(input, 1, false), &ctx)
+            .unwrap()
+            .is_none()
+    );
+}
+
+#[test]
+fn missing_input_is_named() {
+    let (d, _input, ctx) = setup();
+    let missing = d.path().join("nope.tif");
+    let err = execute(writer_stage(missing, 1, false), &ctx).unwrap_err();
+    assert!(format!("{err:#}").contains("nope.tif"), "{err:#}");
+    assert!(!ctx.out_dir.exists());
+}
+
+#[test]
+fn schema_rejects_duplicates_and_unknown_kinds() {
+    let p = std::path::Path::new("pipelines/x.toml");
+    let dup = "[pipeline]\nname='x'\nout='o'\n[[stage]]\nname='a'\nkind='report'\n[[stage]]\nname='a'\nkind='report'\n";
+    let e = schema::Pipeline::parse(dup, p).unwrap_err();
+    assert!(format!("{e:#}").contains("two stages are named 'a'"), "{e:#}");
+    let unk = "[pipeline]\nname='x'\nout='o'\n[[stage]]\nname='a'\nkind='radiogrph'\n";
+    let e = schema::Pipeline::parse(unk, p).unwrap_err();
+    assert!(format!("{e:#}").contains("unknown kind 'radiogrph'"), "{e:#}");
+    let ok = "[pipeline]\nname='x'\nroot='..'\nout='reports/x'\n[[stage]]\nname='a'\nkind='report'\n";
+    let pl = schema::Pipeline::parse(ok, p).unwrap();
+    assert_eq!(pl.out_dir(), PathBuf::from("pipelines/../reports/x"));
+}

@@ -1,0 +1,139 @@
+//! Bad input gets a clear error that names the file or parameter, and nothing is written.
+
+use lbdem::io::tiff::{write_u8, write_u16};
+use lbdem::stages::radiograph::{Params, Radiograph};
+use lbdem::stages::{Stage, StageContext};
+use lbdem_imaging::tiff::encoder::{TiffEncoder, colortype};
+use ndarray::Array2;
+use std::path::Path;
+
+fn frame(h: usize, w: usize, v: u16) -> Array2<u16> {
+    Array2::from_shape_fn(
+        (h, w),
+        |(r, c)| if c < w / 2 { v } else { v / 4 + (r % 3) as u16 },
+    )
+}
+
+/// Base parameters over two good 64x64 frames in `dir`, modified by `extra` (TOML lines).
+fn params(dir: &Path, extra: &str) -> Params {
+    let mut t: toml::Table = toml::from_str(&format!(
+        r#"frames = ["{d}/a.tif", "{d}/b.tif"]
+        i_s0_roi = [0, 0, 16, 16]
+        i_l0_roi = [40, 0, 16, 16]
+        mu_s = 2000.0
+        mu_l = 9000.0
+        l_alloy0 = 150e-6
+        d_bar = 10e-6
+        pixel_size = 1e-6
+        plots = false"#,
+        d = dir.display()
+    ))
+    .unwrap();
+    let e: toml::Table = toml::from_str(extra).unwrap();
+    t.extend(e);
+    toml::Value::Table(t).try_into().unwrap()
+}
+
+fn expect_error(dir: &Path, extra: &str, needles: &[&str]) {
+    let out = tempfile::tempdir().unwrap();
+    let ctx = StageContext::new(out.path().into(), "radiograph".into(), dir.into());
+    let err = Radiograph::run(&params(dir, extra), &ctx).expect_err("bad input must fail");
+    let msg = format!("{err:#}");
+    for n in needles {
+        assert!(msg.contains(n), "error for `{extra}` should mention '{n}': {msg}");
+    }
+    let written: Vec<_> = std::fs::read_dir(out.path()).unwrap().collect();
+    assert!(
+        written.is_empty(),
+        "nothing may be written on bad input `{extra}`, found {written:?}"
+    );
+}
+
+fn setup() -> tempfile::TempDir {
+    let d = tempfile::tempdir().unwrap();
+    write_u16(&d.path().join("a.tif"), frame(64, 64, 20000).view()).unwrap();
+    write_u16(&d.path().join("b.tif"), frame(64, 64, 19000).view()).unwrap();
+    write_u16(&d.path().join("small.tif"), frame(32, 64, 19000).view()).unwrap();
+    write_u16(
+        &d.path().join("hot_dark.tif"),
+        Array2::from_elem((64, 64), 30000u16).view(),
+    )
+    .unwrap();
+    write_u8(
+        &d.path().join("eight.tif"),
+        Array2::from_elem((64, 64), 200u8).view(),
+    )
+    .unwrap();
+    // A 32-bit unsigned integer TIFF: a bit depth lbdem does not read.
+    let mut buf = std::io::Cursor::new(Vec::new());
+    TiffEncoder::new(&mut buf)
+        .unwrap()
+        .write_image::<colortype::Gray32>(64, 64, &vec![7u32; 64 * 64])
+        .unwrap();
+    std::fs::write(d.path().join("u32.tif"), buf.into_inner()).unwrap();
+    d
+}
+
+#[test]
+fn good_input_runs() {
+    let d = setup();
+    let out = tempfile::tempdir().unwrap();
+    let ctx = StageContext::new(out.path().into(), "radiograph".into(), d.path().into());
+    let o = Radiograph::run(&params(d.path(), ""), &ctx).unwrap();
+    assert!(o.files.iter().any(|f| f.ends_with("eps_vol_001.tif")));
+}
+
+#[test]
+fn bad_inputs_are_named_and_nothing_is_written() {
+    let d = setup();
+    let p = d.path().display().to_string();
+    expect_error(
+        d.path(),
+        &format!(r#"frames = ["{p}/a.tif", "{p}/missing.tif"]"#),
+        &["missing.tif"],
+    );
+    expect_error(
+        d.path(),
+        &format!(r#"frames = ["{p}/a.tif", "{p}/u32.tif"]"#),
+        &["u32.tif", "32-bit"],
+    );
+    expect_error(
+        d.path(),
+        &format!(r#"frames = ["{p}/a.tif", "{p}/small.tif"]"#),
+        &["small.tif", "32x64"],
+    );
+    expect_error(
+        d.path(),
+        &format!(r#"frames = ["{p}/a.tif", "{p}/eight.tif", "{p}/small.tif"]"#),
+        &["small.tif"],
+    );
+    expect_error(d.path(), "i_l0_roi = [60, 0, 16, 16]", &["i_l0_roi", "outside"]);
+    expect_error(
+        d.path(),
+        "thickness = \"eq2\"\nthickness_roi = [0, 60, 8, 8]",
+        &["thickness_roi"],
+    );
+    expect_error(d.path(), "i_l0 = 0.5", &["exactly one of 'i_l0'"]);
+    expect_error(
+        d.path(),
+        &format!(r#"dark = "{p}/hot_dark.tif""#),
+        &["a.tif", "not positive", "row 0, col 0"],
+    );
+    expect_error(d.path(), "d_bar = 100e-6", &["REV side 316 px", "d_bar"]);
+    expect_error(d.path(), "pixel_size = -1.0", &["pixel_size"]);
+}
+
+#[test]
+fn equal_reference_intensities_are_refused() {
+    let d = setup();
+    let out = tempfile::tempdir().unwrap();
+    let ctx = StageContext::new(out.path().into(), "radiograph".into(), d.path().into());
+    let mut p = params(d.path(), "");
+    (p.i_l0_roi, p.i_s0_roi, p.i_l0, p.i_s0) = (None, None, Some(0.5), Some(0.5));
+    let msg = format!("{:#}", Radiograph::run(&p, &ctx).unwrap_err());
+    assert!(
+        msg.contains("I_S^0") && msg.contains("I_L^0") && msg.contains("equal"),
+        "{msg}"
+    );
+    assert_eq!(std::fs::read_dir(out.path()).unwrap().count(), 0);
+}
