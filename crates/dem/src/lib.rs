@@ -1,1 +1,28 @@
-//! placeholder: see the crate's issue
+//! lbdem-dem: discrete-element engine for rigid clumps of circles (2D), after Su et al. 2020
+//! (Sects. 2.3-2.4, Table 1), Ness et al. 2017 (Eq. 6) and Leonardi et al. 2014 (Sect. 3).
+//!
+//! State is plain data ([`System`]: [`Bodies`], walls, bonds, [`Contacts`]); the [`Stepper`] is
+//! scratch. Contact laws implement [`ContactLaw`]. No file I/O here.
+
+pub mod body;
+pub mod contact;
+pub mod domain;
+pub mod error;
+pub mod generate;
+pub mod neighbor;
+pub mod shape;
+pub mod stepper;
+pub mod system;
+pub mod vector;
+pub mod wall;
+
+pub use body::Bodies;
+pub use contact::{ContactLaw, Damping, History, Law};
+pub use domain::Domain;
+pub use error::DemError;
+pub use neighbor::Contacts;
+pub use shape::{Ball, ClumpShape, MassProps2};
+pub use stepper::{StepParams, Stepper};
+pub use system::{Membrane, System};
+pub use vector::{Vec2, Vector};
+pub use wall::{ServoLength, Wall, WallMotion, WallShape};

@@ -1,0 +1,80 @@
+//! The elastic-plastic normal law of Su et al. 2020 (Sect. 2.3, Table 1, Eq. 6): elastic with
+//! k_n,e up to the yield force F_y, then plastic flow with the small slope k_n,p, elastic
+//! unloading with k_n,e from the plastic state (a permanent overlap remains). F_y is rate
+//! dependent through Eq. 6: F_y − F_0 ≈ 2.40e-8 (du_y/dt)^0.26 (SI: N, m/s), see [`su_yield_force`].
+//! Tangential spring with Coulomb limit, damping and rolling resistance as in the linear law.
+
+use super::{ContactInput, ContactLaw, ContactOutput, Damping, History, Rolling, tangential};
+use crate::vector::Vec2;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElasticPlastic {
+    /// Elastic normal stiffness k_n,e (N/m).
+    pub k_e: f64,
+    /// Slope of the plastic flow regime k_n,p (N/m).
+    pub k_p: f64,
+    /// Yield force F_y (N).
+    pub f_y: f64,
+    pub k_t: f64,
+    pub damping: Damping,
+    pub mu: f64,
+    #[serde(default)]
+    pub rolling: Option<Rolling>,
+}
+
+/// Su et al. 2020 Eq. 6: F_y = F_0 + 2.40e-8 · (du_y/dt)^0.26, with the push-plate speed in m/s
+/// and forces in N.
+pub fn su_yield_force(f0: f64, plate_speed: f64) -> f64 {
+    f0 + 2.40e-8 * plate_speed.abs().powf(0.26)
+}
+
+impl ElasticPlastic {
+    /// Elastic-plastic normal force for overlap `delta`, updating the plastic overlap.
+    #[inline]
+    pub fn normal(&self, delta: f64, h: &mut History) -> f64 {
+        let mut f = self.k_e * (delta - h.delta_p);
+        // Yield envelope: F_y + k_p (δ − F_y/k_e) beyond the yield overlap U_y = F_y/k_e.
+        let env = self.f_y + self.k_p * (delta - self.f_y / self.k_e);
+        if f > env {
+            f = env;
+            h.delta_p = delta - env / self.k_e;
+        }
+        f.max(0.0)
+    }
+}
+
+impl ContactLaw for ElasticPlastic {
+    #[inline]
+    fn force(&self, c: &ContactInput, h: &mut History) -> ContactOutput {
+        let f_el = self.normal(c.delta, h);
+        let cn = self.damping.coefficient(self.k_e, c.m_eff);
+        let vn = c.v_rel.x * c.n.x + c.v_rel.y * c.n.y;
+        let f_n = if f_el > 0.0 {
+            (f_el + cn * vn).max(0.0)
+        } else {
+            0.0
+        };
+        let ft = if self.mu > 0.0 {
+            tangential(c, h, self.k_t, 0.5 * cn, self.mu, f_n)
+        } else {
+            Vec2::ZERO
+        };
+        let m_roll = match &self.rolling {
+            Some(r) => r.torque(c, h, f_n),
+            None => 0.0,
+        };
+        ContactOutput {
+            f: ft - c.n * f_n,
+            m_roll,
+            f_n,
+        }
+    }
+    fn max_stiffness(&self, _r_eff: f64) -> f64 {
+        self.k_e.max(self.k_t)
+    }
+    fn friction(&self) -> f64 {
+        self.mu
+    }
+}

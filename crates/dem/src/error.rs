@@ -1,0 +1,36 @@
+//! Errors of the DEM kernels: each names the parameter, its value, the limit and the fix.
+
+use thiserror::Error;
+
+#[derive(Debug, Error, PartialEq)]
+pub enum DemError {
+    #[error("a clump needs at least one circle; give the template one or more (x, y, r) rows")]
+    EmptyClump,
+    #[error("circle radius r = {r} must be positive and finite; fix the particle file or generator")]
+    BadRadius { r: f64 },
+    #[error(
+        "time step dt = {dt:e} s is above the critical time step {critical:e} s (= sqrt(m_min/k_max) \
+         with m_min = {m_min:e} kg, k_max = {k_max:e} N/m); lower dt below {critical:e} s or soften the contacts"
+    )]
+    TimeStepTooLarge {
+        dt: f64,
+        critical: f64,
+        m_min: f64,
+        k_max: f64,
+    },
+    #[error(
+        "body {body}: non-finite state at step {step} (position or velocity is NaN/inf); the run blew up, lower dt"
+    )]
+    NonFinite { body: usize, step: u64 },
+    #[error("{name} = {value} is invalid: {why}")]
+    BadParameter {
+        name: &'static str,
+        value: f64,
+        why: &'static str,
+    },
+    #[error(
+        "cell list would need {cells} cells (domain / cutoff); the domain is too large for the particle size \
+         — give a smaller domain (walls) or larger particles"
+    )]
+    TooManyCells { cells: usize },
+}

@@ -1,0 +1,608 @@
+//! The time step: velocity Verlet for translation and rotation (Verlet 1967; Allen & Tildesley,
+//! "Computer Simulation of Liquids", Sect. 3.2), with optional viscous and local (non-viscous,
+//! Cundall) damping. The stepper holds only scratch; all state lives in [`System`].
+//!
+//! Determinism: pair forces are computed per pair in parallel into a per-pair buffer, then each
+//! body gathers its pairs in canonical order; every other reduction runs in a fixed order, so
+//! results are bitwise identical for any number of threads.
+
+use crate::contact::{ContactInput, ContactLaw, History, Law, LinearSpringDashpot};
+use crate::error::DemError;
+use crate::neighbor::{CellList, carry_history};
+use crate::system::System;
+use crate::vector::{Vec2, Vector};
+use crate::wall::update_wall_velocities;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepParams {
+    pub dt: f64,
+    #[serde(default)]
+    pub gravity: Vec2,
+    /// Factor on gravity: 1 for dry grains, 1 − ρ_L/ρ_S for buoyant grains in a liquid.
+    #[serde(default = "one")]
+    pub gravity_factor: f64,
+    /// Viscous damping rate γ (1/s): F −= γ m v, T −= γ I ω.
+    #[serde(default)]
+    pub viscous_damping: f64,
+    /// Local (non-viscous) damping α (Cundall): F_k −= α |F_k| sign(v_k).
+    #[serde(default)]
+    pub local_damping: f64,
+    /// Verlet-list skin (m).
+    pub skin: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl StepParams {
+    pub fn new(dt: f64, skin: f64) -> Self {
+        Self {
+            dt,
+            gravity: Vec2::ZERO,
+            gravity_factor: 1.0,
+            viscous_damping: 0.0,
+            local_damping: 0.0,
+            skin,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct PairOut {
+    f: Vec2,
+    ti: f64,
+    tj: f64,
+    touch: bool,
+}
+
+/// What the pair loop reads of a circle, packed in one cache line.
+#[derive(Clone, Copy, Debug, Default)]
+struct CircleState {
+    pos: Vec2,
+    /// Velocity of the circle centre.
+    vel: Vec2,
+    omega: f64,
+    r: f64,
+    mass: f64,
+}
+
+/// Scratch for stepping a [`System`].
+#[derive(Default)]
+pub struct Stepper {
+    cells: CellList,
+    cpos: Vec<Vec2>,
+    carm: Vec<Vec2>,
+    cstate: Vec<CircleState>,
+    ref_pos: Vec<Vec2>,
+    out: Vec<PairOut>,
+    /// Per circle: entries into `out` (pair index << 1 | 1 if the circle is j).
+    csr_start: Vec<u32>,
+    csr: Vec<u32>,
+    wall_buf: Vec<(Vec2, f64)>,
+    n_circles: usize,
+    checked_dt: f64,
+    pub rebuilds: u64,
+}
+
+impl Stepper {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Critical time step of `sys` under `law` (and `wall_law`): sqrt(m_min / k_max).
+    pub fn critical_time_step<L: ContactLaw>(sys: &System, law: &L, wall_law: &L) -> (f64, f64, f64) {
+        let b = &sys.bodies;
+        let m_min = b.mass.iter().copied().fold(f64::INFINITY, f64::min);
+        let r_max = b.circle_r.iter().copied().fold(0.0, f64::max);
+        let mut k = law.max_stiffness(0.5 * r_max).max(wall_law.max_stiffness(r_max));
+        if let Some(p) = &sys.bond_params {
+            k = k.max(p.k_n.max(p.k_s) * 2.0 * p.lambda * r_max);
+        }
+        (lbdem_core::units::dem::critical_time_step(m_min, k), m_min, k)
+    }
+
+    /// [`Stepper::step`] compiled in this crate for the scene-selectable [`Law`]: callers in
+    /// other crates get this crate's optimisation level instead of their own.
+    #[inline(never)]
+    pub fn step_law(
+        &mut self,
+        p: &StepParams,
+        law: &Law,
+        wall_law: &Law,
+        sys: &mut System,
+    ) -> Result<(), DemError> {
+        self.step(p, law, wall_law, sys)
+    }
+
+    /// [`Stepper::step`] for the linear law (benchmark case), compiled in this crate.
+    #[inline(never)]
+    pub fn step_linear(
+        &mut self,
+        p: &StepParams,
+        law: &LinearSpringDashpot,
+        sys: &mut System,
+    ) -> Result<(), DemError> {
+        self.step(p, law, law, sys)
+    }
+
+    /// Number of pairs in contact at the last force evaluation.
+    pub fn n_contacts(&self) -> usize {
+        self.out.iter().filter(|o| o.touch).count()
+    }
+
+    /// Advance `sys` by one step.
+    pub fn step<L: ContactLaw>(
+        &mut self,
+        p: &StepParams,
+        law: &L,
+        wall_law: &L,
+        sys: &mut System,
+    ) -> Result<(), DemError> {
+        let dt = p.dt;
+        if self.checked_dt != dt || self.n_circles != sys.bodies.n_circles() {
+            let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
+            if dt.is_nan() || dt <= 0.0 || dt > crit {
+                return Err(DemError::TimeStepTooLarge {
+                    dt,
+                    critical: crit,
+                    m_min,
+                    k_max,
+                });
+            }
+            self.checked_dt = dt;
+            let fresh = self.n_circles != sys.bodies.n_circles() || self.ref_pos.is_empty();
+            self.n_circles = sys.bodies.n_circles();
+            if fresh {
+                self.update_circles(sys);
+                self.rebuild(sys, p.skin)?;
+                if sys.step == 0 {
+                    // Prime F(0) for the first half-kick; dt = 0 leaves the history untouched.
+                    self.forces(&StepParams { dt: 0.0, ..*p }, law, wall_law, sys, 0.0);
+                }
+            }
+        }
+        self.kick_drift(sys, 0.5 * dt, dt);
+        update_wall_velocities(&mut sys.walls, wall_law.max_stiffness(1.0), dt);
+        for w in sys.walls.iter_mut() {
+            let v = w.vel;
+            w.translate(v * dt);
+        }
+        let worst = self.update_circles(sys);
+        let half_skin2 = 0.25 * p.skin * p.skin;
+        if !worst.is_finite() {
+            let body = (0..sys.bodies.len())
+                .find(|&k| !(sys.bodies.pos[k].norm2().is_finite() && sys.bodies.vel[k].norm2().is_finite()))
+                .unwrap_or(0);
+            return Err(DemError::NonFinite { body, step: sys.step });
+        }
+        if worst > half_skin2 {
+            self.rebuild(sys, p.skin)?;
+        }
+        self.forces(p, law, wall_law, sys, 0.5 * dt);
+        sys.time += dt;
+        sys.step += 1;
+        Ok(())
+    }
+
+    /// Half kick then drift, fused in one pass over the bodies.
+    fn kick_drift(&self, sys: &mut System, h: f64, dt: f64) {
+        let dom = sys.domain;
+        let b = &mut sys.bodies;
+        let (force, mass, torque, inertia) = (&b.force, &b.mass, &b.torque, &b.inertia);
+        b.pos
+            .par_iter_mut()
+            .zip(b.vel.par_iter_mut())
+            .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(k, ((x, v), (a, w)))| {
+                *v += force[k] * (h / mass[k]);
+                *w += torque[k] * h / inertia[k];
+                *x = dom.wrap(*x + *v * dt);
+                *a += *w * dt;
+            });
+    }
+
+    /// World positions, arms and packed pair-loop state of every circle; returns the largest
+    /// squared displacement since the last list build (NaN if any position is not finite).
+    fn update_circles(&mut self, sys: &System) -> f64 {
+        let b = &sys.bodies;
+        let dom = sys.domain;
+        let nc = b.n_circles();
+        self.cpos.resize(nc, Vec2::ZERO);
+        self.carm.resize(nc, Vec2::ZERO);
+        self.cstate.resize(nc, CircleState::default());
+        let have_ref = self.ref_pos.len() == nc;
+        let refp = &self.ref_pos;
+        self.cpos
+            .par_iter_mut()
+            .zip(self.carm.par_iter_mut())
+            .zip(self.cstate.par_iter_mut())
+            .enumerate()
+            .with_min_len(4096)
+            .map(|(c, ((x, a), st))| {
+                let k = b.circle_body[c] as usize;
+                let off = b.circle_offset[c];
+                *a = if off.x == 0.0 && off.y == 0.0 {
+                    Vec2::ZERO
+                } else {
+                    off.rotated(b.angle[k])
+                };
+                *x = b.pos[k] + *a;
+                *st = CircleState {
+                    pos: *x,
+                    vel: b.vel[k] + a.spin(b.omega[k]),
+                    omega: b.omega[k],
+                    r: b.circle_r[c],
+                    mass: b.mass[k],
+                };
+                if have_ref {
+                    dom.min_image(*x - refp[c]).norm2()
+                } else {
+                    x.norm2() * 0.0
+                }
+            })
+            .reduce(
+                || 0.0,
+                |p, q| {
+                    if p.is_nan() || q.is_nan() {
+                        f64::NAN
+                    } else {
+                        p.max(q)
+                    }
+                },
+            )
+    }
+
+    fn rebuild(&mut self, sys: &mut System, skin: f64) -> Result<(), DemError> {
+        let b = &sys.bodies;
+        let pairs = self
+            .cells
+            .build_pairs(&sys.domain, &self.cpos, &b.circle_r, &b.circle_body, skin)?;
+        let hist = carry_history(&sys.contacts.pairs, &sys.contacts.hist, &pairs);
+        sys.contacts.pairs = pairs;
+        sys.contacts.hist = hist;
+        let need = b.n_circles() * sys.walls.len();
+        if sys.contacts.wall_hist.len() != need {
+            sys.contacts.wall_hist.resize(need, History::default());
+        }
+        self.ref_pos.clone_from(&self.cpos);
+        // Per-circle index of pair entries, filled in pair order: canonical partner order.
+        let nc = b.n_circles();
+        self.csr_start.clear();
+        self.csr_start.resize(nc + 1, 0);
+        for pr in &sys.contacts.pairs {
+            self.csr_start[pr[0] as usize + 1] += 1;
+            self.csr_start[pr[1] as usize + 1] += 1;
+        }
+        for c in 0..nc {
+            self.csr_start[c + 1] += self.csr_start[c];
+        }
+        self.csr.clear();
+        self.csr.resize(self.csr_start[nc] as usize, 0);
+        let mut fill: Vec<u32> = self.csr_start[..nc].to_vec();
+        for (k, pr) in sys.contacts.pairs.iter().enumerate() {
+            for (side, &c) in pr.iter().enumerate() {
+                self.csr[fill[c as usize] as usize] = ((k as u32) << 1) | side as u32;
+                fill[c as usize] += 1;
+            }
+        }
+        self.out.resize(sys.contacts.pairs.len(), PairOut::default());
+        self.rebuilds += 1;
+        Ok(())
+    }
+
+    /// Forces and torques on every body; then, if `h > 0`, the closing half kick v += F/m h.
+    fn forces<L: ContactLaw>(&mut self, p: &StepParams, law: &L, wall_law: &L, sys: &mut System, h: f64) {
+        let dt = p.dt;
+        let b = &sys.bodies;
+        let dom = sys.domain;
+        self.cstate.resize(b.n_circles(), CircleState::default());
+        self.cstate
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(c, s)| {
+                let k = b.circle_body[c] as usize;
+                *s = CircleState {
+                    pos: self.cpos[c],
+                    vel: b.vel[k] + self.carm[c].spin(b.omega[k]),
+                    omega: b.omega[k],
+                    r: b.circle_r[c],
+                    mass: b.mass[k],
+                };
+            });
+        let (cpos, carm, cst) = (&self.cpos, &self.carm, &self.cstate);
+        // 1. Pair forces, one per pair, in parallel.
+        sys.contacts
+            .pairs
+            .par_iter()
+            .zip(sys.contacts.hist.par_iter_mut())
+            .zip(self.out.par_iter_mut())
+            .with_min_len(1024)
+            .for_each(|((pr, h), o)| {
+                let (ci, cj) = (&cst[pr[0] as usize], &cst[pr[1] as usize]);
+                let d = dom.min_image(cj.pos - ci.pos);
+                let (ri, rj) = (ci.r, cj.r);
+                let rs = ri + rj;
+                let d2 = d.norm2();
+                if d2 >= rs * rs {
+                    *h = History::default();
+                    *o = PairOut::default();
+                    return;
+                }
+                let dist = d2.sqrt();
+                let n = d * (1.0 / dist);
+                let delta = rs - dist;
+                let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
+                let (wi, wj) = (ci.omega, cj.omega);
+                let vi = ci.vel + (n * ai).spin(wi);
+                let vj = cj.vel - (n * aj).spin(wj);
+                let (mi, mj) = (ci.mass, cj.mass);
+                let c = ContactInput {
+                    delta,
+                    n,
+                    v_rel: vi - vj,
+                    w_rel: wi - wj,
+                    r_eff: ri * rj / rs,
+                    m_eff: mi * mj / (mi + mj),
+                    dt,
+                };
+                let r = law.force(&c, h);
+                let nxf = n.cross(r.f);
+                *o = PairOut {
+                    f: r.f,
+                    ti: ai * nxf + r.m_roll,
+                    tj: aj * nxf - r.m_roll,
+                    touch: true,
+                };
+            });
+        // 2. Gather per body in canonical order. Without walls, bonds or membrane nothing else
+        //    adds to the contact forces, so body forces, damping and the kick follow in the same pass.
+        let g = p.gravity * p.gravity_factor;
+        let fin = Finish {
+            g,
+            gv: p.viscous_damping,
+            al: p.local_damping,
+            h,
+        };
+        let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
+        let (out, csr, cs) = (&self.out, &self.csr, &self.csr_start);
+        let bodies = &mut sys.bodies;
+        let Bodies5 {
+            force,
+            torque,
+            vel,
+            omega,
+            mass,
+            inertia,
+            ext_force,
+            ext_torque,
+            cstart,
+        } = Bodies5::of(bodies);
+        force
+            .par_iter_mut()
+            .zip(torque.par_iter_mut())
+            .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
+            .enumerate()
+            .with_min_len(512)
+            .for_each(|(k, ((f, t), (v, w)))| {
+                let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
+                for c in cstart[k]..cstart[k + 1] {
+                    let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
+                    for &e in &csr[cs[c] as usize..cs[c + 1] as usize] {
+                        let o = &out[(e >> 1) as usize];
+                        if e & 1 == 0 {
+                            fc += o.f;
+                            tc += o.ti;
+                        } else {
+                            fc -= o.f;
+                            tc += o.tj;
+                        }
+                    }
+                    fb += fc;
+                    tb += tc + carm[c].cross(fc);
+                }
+                *f = fb;
+                *t = tb;
+                if simple {
+                    fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
+                }
+            });
+        if simple {
+            return;
+        }
+        // 3. Walls: per circle in parallel, then a sequential sum in circle order.
+        let nw = sys.walls.len();
+        if nw > 0 {
+            let b = &sys.bodies;
+            let walls = &sys.walls;
+            self.wall_buf.resize(b.n_circles() * nw, (Vec2::ZERO, 0.0));
+            self.wall_buf
+                .par_chunks_mut(nw)
+                .zip(sys.contacts.wall_hist.par_chunks_mut(nw))
+                .enumerate()
+                .with_min_len(256)
+                .for_each(|(c, (buf, hist))| {
+                    let k = b.circle_body[c] as usize;
+                    let r = b.circle_r[c];
+                    for w in 0..nw {
+                        match walls[w].touch(cpos[c], r) {
+                            None => {
+                                hist[w] = History::default();
+                                buf[w] = (Vec2::ZERO, 0.0);
+                            }
+                            Some((delta, n)) => {
+                                let a = r - delta;
+                                let arm = carm[c] + n * a;
+                                let v = b.vel[k] + arm.spin(b.omega[k]);
+                                let ci = ContactInput {
+                                    delta,
+                                    n,
+                                    v_rel: v - walls[w].vel,
+                                    w_rel: b.omega[k],
+                                    r_eff: r,
+                                    m_eff: b.mass[k],
+                                    dt,
+                                };
+                                let o = wall_law.force(&ci, &mut hist[w]);
+                                buf[w] = (o.f, arm.cross(o.f) + o.m_roll);
+                            }
+                        }
+                    }
+                });
+            let mut wf = vec![Vec2::ZERO; nw];
+            let mut wn = vec![0u32; nw];
+            let bodies = &mut sys.bodies;
+            for c in 0..bodies.n_circles() {
+                let k = bodies.circle_body[c] as usize;
+                for (w, wfw) in wf.iter_mut().enumerate() {
+                    let (f, t) = self.wall_buf[c * nw + w];
+                    bodies.force[k] += f;
+                    bodies.torque[k] += t;
+                    *wfw -= f;
+                    wn[w] += u32::from(f != Vec2::ZERO);
+                }
+            }
+            for ((w, f), n) in sys.walls.iter_mut().zip(wf).zip(wn) {
+                w.force = f;
+                w.n_contacts = n;
+            }
+        }
+        // 4. Bonds, sequentially in bond order.
+        if let Some(bp) = sys.bond_params {
+            let bodies = &mut sys.bodies;
+            for bond in sys.bonds.iter_mut().filter(|b| !b.broken) {
+                let (i, j) = (bond.i as usize, bond.j as usize);
+                let d = dom.min_image(cpos[j] - cpos[i]);
+                let dist = d.norm();
+                let n = d * (1.0 / dist);
+                let (ri, rj) = (bodies.circle_r[i], bodies.circle_r[j]);
+                let (bi, bj) = (bodies.circle_body[i] as usize, bodies.circle_body[j] as usize);
+                // Contact point: midway through the gap/overlap.
+                let ai = ri + 0.5 * (dist - ri - rj);
+                let aj = dist - ai;
+                let vi = bodies.vel[bi] + (carm[i] + n * ai).spin(bodies.omega[bi]);
+                let vj = bodies.vel[bj] + (carm[j] - n * aj).spin(bodies.omega[bj]);
+                let c = ContactInput {
+                    delta: ri + rj - dist,
+                    n,
+                    v_rel: vi - vj,
+                    w_rel: bodies.omega[bi] - bodies.omega[bj],
+                    r_eff: ri * rj / (ri + rj),
+                    m_eff: 0.0,
+                    dt,
+                };
+                let (f, m) = bond.update(&bp, &c, ri, rj);
+                let nxf = n.cross(f);
+                bodies.force[bi] += f;
+                bodies.torque[bi] += ai * nxf + m + carm[i].cross(f);
+                bodies.force[bj] -= f;
+                bodies.torque[bj] += aj * nxf - m - carm[j].cross(f);
+            }
+        }
+        // 5. Body forces, drivers, damping.
+        let bodies = &mut sys.bodies;
+        if let Some(mem) = &sys.membrane {
+            for (k, &bk) in mem.bodies.iter().enumerate() {
+                let bk = bk as usize;
+                let f = mem.force_on(k, bodies.pos[bk]);
+                bodies.force[bk] += f;
+            }
+        }
+        let Bodies5 {
+            force,
+            torque,
+            vel,
+            omega,
+            mass,
+            inertia,
+            ext_force,
+            ext_torque,
+            ..
+        } = Bodies5::of(bodies);
+        force
+            .par_iter_mut()
+            .zip(torque.par_iter_mut())
+            .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(k, ((f, t), (v, w)))| {
+                fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
+            });
+    }
+}
+
+/// Body forces, damping and the closing half kick for one body.
+struct Finish {
+    g: Vec2,
+    gv: f64,
+    al: f64,
+    h: f64,
+}
+
+impl Finish {
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn apply(&self, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64, m: f64, i: f64, ef: Vec2, et: f64) {
+        *f += self.g * m + ef;
+        *t += et;
+        if self.gv > 0.0 {
+            *f -= *v * (self.gv * m);
+            *t -= self.gv * i * *w;
+        }
+        if self.al > 0.0 {
+            f.x -= self.al * f.x.abs() * sign(v.x);
+            f.y -= self.al * f.y.abs() * sign(v.y);
+            *t -= self.al * t.abs() * sign(*w);
+        }
+        if self.h != 0.0 {
+            *v += *f * (self.h / m);
+            *w += *t * self.h / i;
+        }
+    }
+}
+
+#[inline]
+fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// Split borrows of the fields the force passes need.
+struct Bodies5<'a> {
+    force: &'a mut Vec<Vec2>,
+    torque: &'a mut Vec<f64>,
+    vel: &'a mut Vec<Vec2>,
+    omega: &'a mut Vec<f64>,
+    mass: &'a [f64],
+    inertia: &'a [f64],
+    ext_force: &'a [Vec2],
+    ext_torque: &'a [f64],
+    cstart: &'a [usize],
+}
+
+impl<'a> Bodies5<'a> {
+    fn of(b: &'a mut crate::body::Bodies) -> Self {
+        Self {
+            force: &mut b.force,
+            torque: &mut b.torque,
+            vel: &mut b.vel,
+            omega: &mut b.omega,
+            mass: &b.mass,
+            inertia: &b.inertia,
+            ext_force: &b.ext_force,
+            ext_torque: &b.ext_torque,
+            cstart: &b.circle_start,
+        }
+    }
+}
