@@ -30,7 +30,8 @@ fn err(dir: &Path, params: &str) -> String {
 fn disks(extra: impl Fn(usize, usize) -> bool) -> ndarray::Array2<f64> {
     ndarray::Array2::from_shape_fn((80, 120), |(r, c)| {
         let (x, y) = (c as f64 + 0.5, r as f64 + 0.5);
-        let d = ((x - 35.0).powi(2) + (y - 40.0).powi(2)).sqrt() < 15.0 || ((x - 80.0).powi(2) + (y - 40.0).powi(2)).sqrt() < 18.0;
+        let d = ((x - 35.0).powi(2) + (y - 40.0).powi(2)).sqrt() < 15.0
+            || ((x - 80.0).powi(2) + (y - 40.0).powi(2)).sqrt() < 18.0;
         if d || extra(r, c) { 0.9 } else { 0.1 }
     })
 }
@@ -46,7 +47,10 @@ fn empty_file_is_named() {
 #[test]
 fn tiny_image_is_empty() {
     let dir = tempfile::tempdir().unwrap();
-    save_png(&dir.path().join("one.png"), &ndarray::Array2::from_elem((1, 1), 0.5));
+    save_png(
+        &dir.path().join("one.png"),
+        &ndarray::Array2::from_elem((1, 1), 0.5),
+    );
     let e = err(dir.path(), "image = \"one.png\"\npixel_size_m = 1e-5");
     assert!(e.contains("image is empty (1 x 1 pixels)"), "{e}");
 }
@@ -54,7 +58,10 @@ fn tiny_image_is_empty() {
 #[test]
 fn uniform_image_has_no_grains() {
     let dir = tempfile::tempdir().unwrap();
-    save_png(&dir.path().join("flat.png"), &ndarray::Array2::from_elem((50, 50), 0.5));
+    save_png(
+        &dir.path().join("flat.png"),
+        &ndarray::Array2::from_elem((50, 50), 0.5),
+    );
     let e = err(dir.path(), "image = \"flat.png\"\npixel_size_m = 1e-5");
     assert!(e.contains("uniform") && e.contains("flat.png"), "{e}");
 }
@@ -63,7 +70,10 @@ fn uniform_image_has_no_grains() {
 fn threshold_above_everything_finds_no_grains() {
     let dir = tempfile::tempdir().unwrap();
     save_png(&dir.path().join("d.png"), &disks(|_, _| false));
-    let e = err(dir.path(), "image = \"d.png\"\npixel_size_m = 1e-5\nthreshold = 250.0");
+    let e = err(
+        dir.path(),
+        "image = \"d.png\"\npixel_size_m = 1e-5\nthreshold = 250.0",
+    );
     assert!(e.contains("no grains found") && e.contains("threshold"), "{e}");
 }
 
@@ -75,15 +85,25 @@ fn container_outside_the_image_covers_nothing() {
         dir.path(),
         "image = \"d.png\"\npixel_size_m = 1e-5\ncontainer = { kind = \"rect\", x0 = 500.0, y0 = 0.0, x1 = 600.0, y1 = 50.0 }",
     );
-    assert!(e.contains("mask covers nothing") && e.contains("rectangle"), "{e}");
+    assert!(
+        e.contains("mask covers nothing") && e.contains("rectangle"),
+        "{e}"
+    );
 }
 
 #[test]
 fn a_grain_of_a_few_pixels_is_reported() {
     let dir = tempfile::tempdir().unwrap();
     // A 2 x 2 pixel grain at x = 110, y = 10.
-    save_png(&dir.path().join("d.png"), &disks(|r, c| (10..12).contains(&r) && (110..112).contains(&c)));
-    let o = run(dir.path(), "image = \"d.png\"\npixel_size_m = 1e-5\nsmooth_px = 0.0").unwrap();
+    save_png(
+        &dir.path().join("d.png"),
+        &disks(|r, c| (10..12).contains(&r) && (110..112).contains(&c)),
+    );
+    let o = run(
+        dir.path(),
+        "image = \"d.png\"\npixel_size_m = 1e-5\nsmooth_px = 0.0",
+    )
+    .unwrap();
     let warnings = o.summary["warnings"].to_string();
     assert!(warnings.contains("4 px at x = 111.0, y = 11.0"), "{warnings}");
     assert_eq!(o.summary["n_grains"], 2);
@@ -92,7 +112,9 @@ fn a_grain_of_a_few_pixels_is_reported() {
 #[test]
 fn missing_pixel_size_is_named() {
     let dir = tempfile::tempdir().unwrap();
-    let e = toml::from_str::<<Digitise as Stage>::Params>("image = \"d.png\"").unwrap_err().to_string();
+    let e = toml::from_str::<<Digitise as Stage>::Params>("image = \"d.png\"")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("pixel_size_m"), "{e}");
     save_png(&dir.path().join("d.png"), &disks(|_, _| false));
     let e = err(dir.path(), "image = \"d.png\"\npixel_size_m = 0.0");

@@ -9,7 +9,10 @@ use lbdem::stages::digitise::Digitise;
 use lbdem::stages::{Stage, StageContext};
 use std::path::Path;
 
-const PHOTO: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/real/pegs-photoelastic-disks/Step09-0001.jpg");
+const PHOTO: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../shared/data/real/pegs-photoelastic-disks/Step09-0001.jpg"
+);
 
 #[test]
 fn finds_the_disks_in_the_box_and_their_two_sizes() {
@@ -23,11 +26,19 @@ fn finds_the_disks_in_the_box_and_their_two_sizes() {
          min_grain_area_px = 400\nmax_hole_area_px = 400\n"
     );
     let p: <Digitise as Stage>::Params = toml::from_str(&params).unwrap();
-    let ctx = StageContext::new(dir.path().to_path_buf(), "digitise".into(), dir.path().to_path_buf());
+    let ctx = StageContext::new(
+        dir.path().to_path_buf(),
+        "digitise".into(),
+        dir.path().to_path_buf(),
+    );
     let o = Digitise::run(&p, &ctx).unwrap();
     let s = &o.summary;
     eprintln!("{}", serde_json::to_string_pretty(s).unwrap());
-    assert!(s["container"].as_str().unwrap().contains("detected box"), "{}", s["container"]);
+    assert!(
+        s["container"].as_str().unwrap().contains("detected box"),
+        "{}",
+        s["container"]
+    );
     assert_eq!(s["circles_outside_container"], 0);
     // Grains: all disks, counted by eye.
     let n = s["n_grains"].as_u64().unwrap();
@@ -37,14 +48,27 @@ fn finds_the_disks_in_the_box_and_their_two_sizes() {
     let mut lines = csv.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
     let k = head.iter().position(|&h| h == "d_eq_m").unwrap();
-    let mut d: Vec<f64> = lines.map(|l| l.split(',').nth(k).unwrap().parse().unwrap()).collect();
+    let mut d: Vec<f64> = lines
+        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+        .collect();
     d.sort_by(f64::total_cmp);
-    let (gap_at, gap) = (1..d.len()).map(|i| (i, d[i] - d[i - 1])).max_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
+    let (gap_at, gap) = (1..d.len())
+        .map(|i| (i, d[i] - d[i - 1]))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap();
     let (small, large) = d.split_at(gap_at);
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    let cv = |v: &[f64]| (v.iter().map(|x| (x - mean(v)).powi(2)).sum::<f64>() / v.len() as f64).sqrt() / mean(v);
-    eprintln!("small {} (mean {:.4e}, cv {:.3}), large {} (mean {:.4e}, cv {:.3}), gap {gap:.3e}",
-        small.len(), mean(small), cv(small), large.len(), mean(large), cv(large));
+    let cv =
+        |v: &[f64]| (v.iter().map(|x| (x - mean(v)).powi(2)).sum::<f64>() / v.len() as f64).sqrt() / mean(v);
+    eprintln!(
+        "small {} (mean {:.4e}, cv {:.3}), large {} (mean {:.4e}, cv {:.3}), gap {gap:.3e}",
+        small.len(),
+        mean(small),
+        cv(small),
+        large.len(),
+        mean(large),
+        cv(large)
+    );
     assert_eq!((small.len(), large.len()), (15, 14));
     assert!(mean(large) / mean(small) > 1.2);
     assert!(cv(small) < 0.06 && cv(large) < 0.06);

@@ -16,38 +16,72 @@ fn save_png(path: &Path, img: &ndarray::Array2<f64>) {
 #[test]
 fn cli_writes_the_assembly_with_its_header() {
     let dir = tempfile::tempdir().unwrap();
-    let s = generate(&SynthSpec { width: 400, height: 300, n_grains: 60, d_mean_px: 36.0, d_spread: 0.25, seed: 5, ..SynthSpec::default() });
+    let s = generate(&SynthSpec {
+        width: 400,
+        height: 300,
+        n_grains: 60,
+        d_mean_px: 36.0,
+        d_spread: 0.25,
+        seed: 5,
+        ..SynthSpec::default()
+    });
     save_png(&dir.path().join("first.png"), &s.image);
     let px = 2.7e-6;
-    std::fs::write(dir.path().join("digitise.toml"), format!("image = \"first.png\"\npixel_size_m = {px}\n")).unwrap();
+    std::fs::write(
+        dir.path().join("digitise.toml"),
+        format!("image = \"first.png\"\npixel_size_m = {px}\n"),
+    )
+    .unwrap();
     let out = dir.path().join("out");
     let st = Command::new(env!("CARGO_BIN_EXE_lbdem"))
-        .args(["digitise", dir.path().join("digitise.toml").to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .args([
+            "digitise",
+            dir.path().join("digitise.toml").to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
         .output()
         .unwrap();
     assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
-    for f in ["particles.csv", "particles.json", "grains.csv", "templates.csv", "size_distribution.csv", "overlay.png"] {
+    for f in [
+        "particles.csv",
+        "particles.json",
+        "grains.csv",
+        "templates.csv",
+        "size_distribution.csv",
+        "overlay.png",
+    ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
-    let header: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("particles.json")).unwrap()).unwrap();
+    let header: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("particles.json")).unwrap()).unwrap();
     assert_eq!(header["units"], "m");
     assert_eq!(header["pixel_size_m"].as_f64().unwrap(), px);
     assert!(header["axes"].as_str().unwrap().contains("y up"));
     let csv = std::fs::read_to_string(out.join("particles.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some("grain_id,x,y,r"));
-    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
     let n_grains = rows.iter().map(|r| r[0] as usize).max().unwrap();
     assert_eq!(n_grains, s.grains.len(), "grain count");
     // y up: a true grain near the top of the image has a large y in metres.
     let top = s.grains.iter().min_by(|a, b| a.y.total_cmp(&b.y)).unwrap();
     let y_top_m = (300.0 - top.y) * px;
-    assert!(rows.iter().any(|r| (r[2] - y_top_m).abs() < 20.0 * px), "no circle near the top grain's y = {y_top_m}");
+    assert!(
+        rows.iter().any(|r| (r[2] - y_top_m).abs() < 20.0 * px),
+        "no circle near the top grain's y = {y_top_m}"
+    );
     // Mean diameter in metres within 3 % of the truth.
-    let stage: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("stage.json")).unwrap_or_default())
-        .unwrap_or(serde_json::Value::Null);
+    let stage: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("stage.json")).unwrap_or_default())
+            .unwrap_or(serde_json::Value::Null);
     let d_true = s.grains.iter().map(|g| g.d_eq_px).sum::<f64>() / s.grains.len() as f64 * px;
     let d_bar = header["d_bar_m"].as_f64().unwrap();
-    assert!((d_bar - d_true).abs() / d_true < 0.03, "d_bar {d_bar} vs {d_true}");
+    assert!(
+        (d_bar - d_true).abs() / d_true < 0.03,
+        "d_bar {d_bar} vs {d_true}"
+    );
     let _ = stage;
 }

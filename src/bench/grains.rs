@@ -28,10 +28,21 @@ struct Row {
 
 pub fn run(a: &BenchArgs) -> Result<()> {
     let (side, n) = if a.quick { (560, 300) } else { (1100, 1000) };
-    let spec = SynthSpec { width: side, height: side, n_grains: n, d_mean_px: 30.0, d_spread: 0.25, seed: 11, ..SynthSpec::default() };
+    let spec = SynthSpec {
+        width: side,
+        height: side,
+        n_grains: n,
+        d_mean_px: 30.0,
+        d_spread: 0.25,
+        seed: 11,
+        ..SynthSpec::default()
+    };
     let img = generate(&spec);
     let pixels = side * side;
-    println!("grains: synthetic {side} x {side} px image with {} grains (d = 30 px +- 25 %)", img.grains.len());
+    println!(
+        "grains: synthetic {side} x {side} px image with {} grains (d = 30 px +- 25 %)",
+        img.grains.len()
+    );
     let params = Params::default();
     let mut rows = Vec::new();
     for threads in [1, 2] {

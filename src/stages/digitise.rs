@@ -109,7 +109,10 @@ impl Params {
             container: self.container.clone(),
             min_grain_area_px: self.min_grain_area_px,
             max_hole_area_px: self.max_hole_area_px,
-            watershed: WatershedParams { h_rel: self.h_rel, h_abs: self.h_abs },
+            watershed: WatershedParams {
+                h_rel: self.h_rel,
+                h_abs: self.h_abs,
+            },
             round_aspect: self.round_aspect,
             n_templates: self.n_templates,
         }
@@ -157,7 +160,13 @@ impl Stage for Digitise {
     }
 }
 
-fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Loaded, d: &Digitised) -> Result<StageOutput> {
+fn write_outputs(
+    p: &Params,
+    ctx: &StageContext,
+    src: &Path,
+    loaded: &load::Loaded,
+    d: &Digitised,
+) -> Result<StageOutput> {
     let out = &ctx.out_dir;
     let px = p.pixel_size_m;
     let (h, w) = loaded.grey.dim();
@@ -173,14 +182,23 @@ fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Load
                 d.templates[k]
                     .circles
                     .iter()
-                    .map(|t| lbdem_grains::FitCircle { x: g.x + t.x * c, y: g.y + t.x * s, r: t.r })
+                    .map(|t| lbdem_grains::FitCircle {
+                        x: g.x + t.x * c,
+                        y: g.y + t.x * s,
+                        r: t.r,
+                    })
                     .collect()
             }
             _ => f.circles.clone(),
         };
         for c in circles {
             let [x, y] = to_si(c.x, c.y);
-            particles.push(Particle { grain_id: i + 1, x, y, r: c.r * px });
+            particles.push(Particle {
+                grain_id: i + 1,
+                x,
+                y,
+                r: c.r * px,
+            });
         }
     }
     write_particles(&out.join("particles.csv"), &particles)?;
@@ -212,7 +230,8 @@ fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Load
             solid_fraction_fitted: d.solid_fraction_fitted,
         },
     )?;
-    o.files.extend(["particles.csv", "particles.json"].map(PathBuf::from));
+    o.files
+        .extend(["particles.csv", "particles.json"].map(PathBuf::from));
 
     // Per grain.
     let col = |f: &dyn Fn(usize) -> f64| (0..d.grains.len()).map(f).collect::<Vec<f64>>();
@@ -254,7 +273,9 @@ fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Load
     });
 
     // Templates.
-    let tc = |f: &dyn Fn(&lbdem_grains::templates::Template) -> f64| d.templates.iter().map(f).collect::<Vec<f64>>();
+    let tc = |f: &dyn Fn(&lbdem_grains::templates::Template) -> f64| {
+        d.templates.iter().map(f).collect::<Vec<f64>>()
+    };
     table::write_csv(
         &out.join("templates.csv"),
         &[
@@ -280,7 +301,11 @@ fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Load
 
     // Distributions (grains not cut by the container edge).
     let interior: Vec<usize> = (0..d.grains.len()).filter(|&i| !d.grains[i].at_edge).collect();
-    let sel: Vec<usize> = if interior.is_empty() { (0..d.grains.len()).collect() } else { interior };
+    let sel: Vec<usize> = if interior.is_empty() {
+        (0..d.grains.len()).collect()
+    } else {
+        interior
+    };
     let dvals: Vec<f64> = sel.iter().map(|&i| d.grains[i].d_eq_px * px * 1e6).collect();
     let avals: Vec<f64> = sel.iter().map(|&i| d.grains[i].aspect).collect();
     for (name, vals, label, what) in [
@@ -302,13 +327,26 @@ fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Load
             .collect();
         table::write_csv(
             &out.join(format!("{name}.csv")),
-            &[(format!("{label}_bin_centre").as_str(), &centres), ("count", &cnt), ("cumulative_fraction", &cum)],
+            &[
+                (format!("{label}_bin_centre").as_str(), &centres),
+                ("count", &cnt),
+                ("cumulative_fraction", &cum),
+            ],
         )?;
         o.tables.push(Table {
             path: format!("{name}.csv").into(),
-            caption: format!("Distribution of the grain {what}, {} grains not cut by the container edge.", vals.len()),
+            caption: format!(
+                "Distribution of the grain {what}, {} grains not cut by the container edge.",
+                vals.len()
+            ),
         });
-        plot::histogram_png(&out.join(format!("{name}.png")), vals, p.histogram_bins, &format!("Grain {what}"), what)?;
+        plot::histogram_png(
+            &out.join(format!("{name}.png")),
+            vals,
+            p.histogram_bins,
+            &format!("Grain {what}"),
+            what,
+        )?;
         o.figures.push(Figure {
             path: format!("{name}.png").into(),
             caption: format!("Histogram of the grain {what} ({} grains).", vals.len()),
@@ -322,7 +360,12 @@ fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Load
         .zip(&d.fits)
         .flat_map(|(g, f)| {
             let class = if g.at_edge { 2 } else { f.circles.len() - 1 };
-            f.circles.iter().map(move |c| plot::Circle { x: c.x, y: c.y, r: c.r, class })
+            f.circles.iter().map(move |c| plot::Circle {
+                x: c.x,
+                y: c.y,
+                r: c.r,
+                class,
+            })
         })
         .collect();
     plot::circles_overlay_png(&out.join("overlay.png"), loaded.grey.view(), &circles)?;
@@ -331,7 +374,9 @@ fn write_outputs(p: &Params, ctx: &StageContext, src: &Path, loaded: &load::Load
         caption: format!(
             "Fitted circles over {}: {} grains, {} circles (one colour per class: single circle, pair, \
              grain cut by the container). Container: {}.",
-            src.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+            src.file_name()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
             d.grains.len(),
             circles.len(),
             d.mask.description

@@ -25,21 +25,28 @@ pub struct Loaded {
     pub grey: Array2<f64>,
     /// "float" for a float TIFF (solid fraction), else the colour type read.
     pub kind: String,
-    /// Full-scale value of the integer type (255, 65535), 1 for float.
-    pub full_scale: f64,
 }
 
 pub fn load(path: &Path, channel: Channel) -> Result<Loaded> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read image file {}", path.display()))?;
     if bytes.is_empty() {
-        bail!("image file {} is empty (0 bytes): give a PNG, JPEG or TIFF image", path.display());
+        bail!(
+            "image file {} is empty (0 bytes): give a PNG, JPEG or TIFF image",
+            path.display()
+        );
     }
     let is_tiff = bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*");
-    if is_tiff && let Some(l) = load_float_tiff(&bytes).with_context(|| format!("reading TIFF {}", path.display()))? {
+    if is_tiff
+        && let Some(l) =
+            load_float_tiff(&bytes).with_context(|| format!("reading TIFF {}", path.display()))?
+    {
         return Ok(l);
     }
     let img = image::load_from_memory(&bytes).with_context(|| {
-        format!("cannot decode image file {}: give a PNG, JPEG or TIFF (8/16-bit, or 32-bit float grey)", path.display())
+        format!(
+            "cannot decode image file {}: give a PNG, JPEG or TIFF (8/16-bit, or 32-bit float grey)",
+            path.display()
+        )
     })?;
     let kind = format!("{:?}", img.color());
     let (w, h) = (img.width() as usize, img.height() as usize);
@@ -49,12 +56,16 @@ pub fn load(path: &Path, channel: Channel) -> Result<Loaded> {
     );
     let grey = if is16 {
         let rgb = img.to_rgb16();
-        Array2::from_shape_fn((h, w), |(r, c)| pick(rgb.get_pixel(c as u32, r as u32).0.map(f64::from), channel))
+        Array2::from_shape_fn((h, w), |(r, c)| {
+            pick(rgb.get_pixel(c as u32, r as u32).0.map(f64::from), channel)
+        })
     } else {
         let rgb = img.to_rgb8();
-        Array2::from_shape_fn((h, w), |(r, c)| pick(rgb.get_pixel(c as u32, r as u32).0.map(f64::from), channel))
+        Array2::from_shape_fn((h, w), |(r, c)| {
+            pick(rgb.get_pixel(c as u32, r as u32).0.map(f64::from), channel)
+        })
     };
-    Ok(Loaded { grey, kind, full_scale: if is16 { 65535.0 } else { 255.0 } })
+    Ok(Loaded { grey, kind })
 }
 
 fn pick(p: [f64; 3], channel: Channel) -> f64 {
@@ -84,5 +95,8 @@ fn load_float_tiff(bytes: &[u8]) -> Result<Option<Loaded>> {
     if values.len() != w * h {
         bail!("float TIFF holds {} samples for {w} x {h} pixels", values.len());
     }
-    Ok(Some(Loaded { grey: Array2::from_shape_vec((h, w), values)?, kind: "float".into(), full_scale: 1.0 }))
+    Ok(Some(Loaded {
+        grey: Array2::from_shape_vec((h, w), values)?,
+        kind: "float".into(),
+    }))
 }
