@@ -157,59 +157,95 @@ impl Sat {
         Ok(if n == 0 { f64::NAN } else { s / n as f64 })
     }
 
+    /// One row `r` of the sliding-window REV mean (see [`Sat::rev_mean_into`]).
+    fn rev_row(&self, r: usize, side: usize, need: usize, orow: &mut [f64]) {
+        let (h, w) = self.dim();
+        let lo = side / 2;
+        let hi = side - lo;
+        // Columns whose window is not clipped: c - lo >= 0 and c + hi <= w.
+        let (ci0, ci1) = (lo, (w + 1).saturating_sub(hi).max(lo));
+        let r0 = r.saturating_sub(lo);
+        let r1 = (r + hi).min(h);
+        let slow = |c: usize| {
+            let c0 = c.saturating_sub(lo);
+            let c1 = (c + hi).min(w);
+            let (s, n) = self.window(r0, c0, r1, c1);
+            if n >= need { s / n as f64 } else { f64::NAN }
+        };
+        let rows = (self.s.row(r0).to_slice(), self.s.row(r1).to_slice());
+        let (Some(top), Some(bot), None) = (rows.0, rows.1, &self.count) else {
+            for (c, o) in orow.iter_mut().enumerate() {
+                *o = slow(c);
+            }
+            return;
+        };
+        let n = (r1 - r0) * side;
+        if n >= need && ci1 > ci0 {
+            let inv = 1.0 / n as f64;
+            let len = ci1 - ci0;
+            let (tl, bl_) = (&top[..len], &bot[..len]);
+            let (tr, br) = (&top[side..side + len], &bot[side..side + len]);
+            for ((((o, &a), &b), &c), &d) in orow[ci0..ci1].iter_mut().zip(br).zip(tr).zip(bl_).zip(tl) {
+                *o = (a - b - c + d) * inv;
+            }
+        } else {
+            for (c, o) in orow.iter_mut().enumerate().take(ci1).skip(ci0) {
+                *o = slow(c);
+            }
+        }
+        for c in (0..ci0).chain(ci1..w) {
+            orow[c] = slow(c);
+        }
+    }
+
     /// Sliding-window REV mean centred on every pixel (window rows `r - side/2 ..
     /// r - side/2 + side`, clipped to the image) into `out`. Interior columns of an
     /// unmasked table take a branch-free, vectorisable loop over contiguous rows.
     pub fn rev_mean_into(&self, side: usize, min_valid: f64, out: &mut Array2<f64>) -> Result<()> {
         let (h, w) = self.dim();
         check_side(side, h, w)?;
-        if out.dim() != (h, w) {
+        if out.dim() != (h, w) || !out.is_standard_layout() {
             *out = Array2::zeros((h, w));
         }
         let need = (min_valid * (side * side) as f64).ceil().max(1.0) as usize;
-        let lo = side / 2;
-        let hi = side - lo;
-        // Columns whose window is not clipped: c - lo >= 0 and c + hi <= w.
-        let (ci0, ci1) = (lo, (w + 1).saturating_sub(hi).max(lo));
-        let fast = self.count.is_none() && self.s.is_standard_layout();
+        out.axis_iter_mut(Axis(0)).into_par_iter().enumerate().for_each(|(r, mut orow)| {
+            self.rev_row(r, side, need, orow.as_slice_mut().expect("standard layout"));
+        });
+        Ok(())
+    }
+
+    /// [`Sat::rev_mean_into`] fused with Eq. (5): each REV row is turned into
+    /// `eps_vol = g0 / g - 1` while still in cache (NaN where `g0 < min_gs`), saving a pass.
+    pub fn rev_mean_eps_into(
+        &self,
+        side: usize,
+        min_valid: f64,
+        g0: ArrayView2<f64>,
+        min_gs: f64,
+        out: &mut Array2<f64>,
+        eps: &mut Array2<f64>,
+    ) -> Result<()> {
+        let (h, w) = self.dim();
+        check_side(side, h, w)?;
+        for a in [&mut *out, &mut *eps] {
+            if a.dim() != (h, w) || !a.is_standard_layout() {
+                *a = Array2::zeros((h, w));
+            }
+        }
+        if g0.dim() != (h, w) {
+            return Err(ImagingError::invalid("g0", format!("{:?}", g0.dim()), "must match the frame size"));
+        }
+        let need = (min_valid * (side * side) as f64).ceil().max(1.0) as usize;
         out.axis_iter_mut(Axis(0))
             .into_par_iter()
+            .zip(eps.axis_iter_mut(Axis(0)).into_par_iter())
+            .zip(g0.axis_iter(Axis(0)).into_par_iter())
             .enumerate()
-            .for_each(|(r, mut orow)| {
-                let r0 = r.saturating_sub(lo);
-                let r1 = (r + hi).min(h);
-                let slow = |c: usize| {
-                    let c0 = c.saturating_sub(lo);
-                    let c1 = (c + hi).min(w);
-                    let (s, n) = self.window(r0, c0, r1, c1);
-                    if n >= need { s / n as f64 } else { f64::NAN }
-                };
-                let (Some(orow_s), true) = (orow.as_slice_mut(), fast) else {
-                    for (c, o) in orow.iter_mut().enumerate() {
-                        *o = slow(c);
-                    }
-                    return;
-                };
-                let n = (r1 - r0) * side;
-                let top = self.s.row(r0).to_slice().expect("standard layout");
-                let bot = self.s.row(r1).to_slice().expect("standard layout");
-                if n >= need && ci1 > ci0 {
-                    let inv = 1.0 / n as f64;
-                    let len = ci1 - ci0;
-                    let (tl, bl_) = (&top[..len], &bot[..len]);
-                    let (tr, br) = (&top[side..side + len], &bot[side..side + len]);
-                    for ((((o, &a), &b), &c), &d) in
-                        orow_s[ci0..ci1].iter_mut().zip(br).zip(tr).zip(bl_).zip(tl)
-                    {
-                        *o = (a - b - c + d) * inv;
-                    }
-                } else {
-                    for (c, o) in orow_s.iter_mut().enumerate().take(ci1).skip(ci0) {
-                        *o = slow(c);
-                    }
-                }
-                for c in (0..ci0).chain(ci1..w) {
-                    orow_s[c] = slow(c);
+            .for_each(|(r, ((mut orow, mut erow), grow))| {
+                let o = orow.as_slice_mut().expect("standard layout");
+                self.rev_row(r, side, need, o);
+                for ((e, &g), &a) in erow.iter_mut().zip(o.iter()).zip(grow) {
+                    *e = if a >= min_gs { crate::beer_lambert::eps_vol(a, g) } else { f64::NAN };
                 }
             });
         Ok(())
@@ -321,6 +357,22 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn fused_eps_matches_separate_passes() {
+        let f0 = Array2::from_shape_fn((30, 70), |(r, c)| 0.3 + ((r * 3 + c * 7) % 11) as f64 * 0.03);
+        let f1 = f0.mapv(|v| v * 0.97 + 0.01);
+        let mut sat = Sat::new();
+        sat.build(f0.view());
+        let g0 = sat.rev_mean(7, 0.5).unwrap();
+        sat.build(f1.view());
+        let g1 = sat.rev_mean(7, 0.5).unwrap();
+        let (mut g, mut e) = (Array2::zeros((0, 0)), Array2::zeros((0, 0)));
+        sat.rev_mean_eps_into(7, 0.5, g0.view(), 0.1, &mut g, &mut e).unwrap();
+        let e_ref = crate::beer_lambert::eps_vol_field(g0.view(), g1.view(), 0.1);
+        assert!(g.iter().zip(&g1).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(e.iter().zip(&e_ref).all(|(a, b)| a.to_bits() == b.to_bits()));
     }
 
     #[test]
