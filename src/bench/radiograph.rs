@@ -4,8 +4,9 @@
 //! move per second to the STREAM triad bandwidth measured in the same run.
 //!
 //! Bytes counted per pixel (STREAM convention: reads plus writes, no write-allocate):
-//! u16 frame read 2, SAT row pass write 8, column pass read+write 16, fused REV window and
-//! Eq. (5) pass: read 2 x 8 (top and bottom SAT rows) + 8 (g0), write 8 (g_S) + 8 (eps): 66 B/px.
+//! SAT pass: u16 frame read twice (strip totals, then strip prefixes) 2 x 2, table written
+//! once 8 (`Sat::build_u16`); fused REV window and Eq. (5) pass: read 2 x 8 (top and bottom
+//! SAT rows) + 8 (g0), write 8 (g_S) + 8 (eps): 52 B/px.
 
 use super::{BenchArgs, bandwidth, median};
 use anyhow::Result;
@@ -16,7 +17,7 @@ use lbdem_imaging::synth::{self, Beam, GrainShape};
 use ndarray::Array2;
 use std::time::Instant;
 
-const BYTES_PER_PX: f64 = 66.0;
+const BYTES_PER_PX: f64 = 52.0;
 
 /// Synthetic raw frames (frame 0 and a 5% thinner frame) of `n` x `n` px.
 fn frames(n: usize) -> Result<Vec<Array2<u16>>> {
