@@ -4,8 +4,9 @@
 //! move per second to the STREAM triad bandwidth measured in the same run.
 //!
 //! Bytes counted per pixel (STREAM convention: reads plus writes, no write-allocate):
-//! u16 frame read 2, SAT row pass write 8, column pass read+write 16, REV window pass
-//! read 2 x 8 (top and bottom rows) + write 8, Eq. (5) read 2 x 8 + write 8: 74 B/px.
+//! SAT pass: u16 frame read twice (strip totals, then strip prefixes) 2 x 2, table written
+//! once 8 (`Sat::build_u16`); fused REV window and Eq. (5) pass: read 2 x 8 (top and bottom
+//! SAT rows) + 8 (g0), write 8 (g_S) + 8 (eps): 52 B/px.
 
 use super::{BenchArgs, bandwidth, median};
 use anyhow::Result;
@@ -16,7 +17,7 @@ use lbdem_imaging::synth::{self, Beam, GrainShape};
 use ndarray::Array2;
 use std::time::Instant;
 
-const BYTES_PER_PX: f64 = 74.0;
+const BYTES_PER_PX: f64 = 52.0;
 
 /// Synthetic raw frames (frame 0 and a 5% thinner frame) of `n` x `n` px.
 fn frames(n: usize) -> Result<Vec<Array2<u16>>> {
@@ -78,8 +79,7 @@ fn time_frames(threads: usize, raw: &[Array2<u16>], reps: usize) -> Result<f64> 
                 let ln_ = bl::thickness_eq2(l0, mu_s, mu_l, i_l0, roi_mean(f, liquid), 0.0, 0.0);
                 let map = FractionMap::eq4(i_l0, mu_s, mu_l, l0, ln_)?;
                 sat.build_u16(f.view(), &map.lut_u16());
-                sat.rev_mean_into(side, 0.5, &mut gn)?;
-                bl::eps_vol_into(g0.view(), gn.view(), 0.1, &mut eps);
+                sat.rev_mean_eps_into(side, 0.5, g0.view(), 0.1, &mut gn, &mut eps)?;
             }
             per_frame.push(t.elapsed().as_secs_f64() / frames as f64);
             std::hint::black_box(&eps);

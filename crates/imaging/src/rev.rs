@@ -95,20 +95,56 @@ impl Sat {
             return self.build(f.view());
         }
         self.reset(h, w, false);
-        self.s
+        // One pass writing the table: per row, the total of each fixed 256-column strip
+        // (a cheap read of the 2-byte counts) gives every strip its row-prefix offset, so
+        // strips then run in parallel, each adding its row prefix to the row above (still
+        // in L1) — the table is written once, with no separate column pass. Strips and
+        // summation order are fixed, so the result does not depend on the thread count.
+        let nstrip = w.div_ceil(COL_STRIP);
+        let mut offsets = Array2::<f64>::zeros((h, nstrip));
+        offsets
             .axis_iter_mut(Axis(0))
             .into_par_iter()
-            .skip(1)
             .zip(raw.axis_iter(Axis(0)))
-            .for_each(|(mut srow, rrow)| {
+            .for_each(|(mut orow, rrow)| {
                 let mut acc = 0.0;
-                srow[0] = 0.0;
-                for (o, &c) in srow.iter_mut().skip(1).zip(rrow) {
-                    acc += lut[c as usize];
+                for (k, o) in orow.iter_mut().enumerate() {
                     *o = acc;
+                    let end = ((k + 1) * COL_STRIP).min(w);
+                    acc += (k * COL_STRIP..end).map(|c| lut[rrow[c] as usize]).sum::<f64>();
                 }
             });
-        self.column_pass();
+        let w1 = w + 1;
+        let data = self.s.as_slice_mut().expect("standard layout");
+        data[..w1].fill(0.0);
+        for r in 0..=h {
+            data[r * w1] = 0.0;
+        }
+        let strips: Vec<(usize, usize)> = (0..nstrip)
+            .map(|k| (k * COL_STRIP, ((k + 1) * COL_STRIP).min(w)))
+            .collect();
+        // Each strip writes columns c0+1..=c1 of every row: hand out disjoint raw pointers.
+        struct Ptr(*mut f64);
+        unsafe impl Send for Ptr {}
+        unsafe impl Sync for Ptr {}
+        let base = Ptr(data.as_mut_ptr());
+        strips.par_iter().enumerate().for_each(|(k, &(c0, c1))| {
+            let base = &base;
+            for r in 0..h {
+                let rrow = raw.row(r);
+                let mut acc = offsets[[r, k]];
+                // SAFETY: rows r and r+1 of the (h+1) x (w+1) table, columns c0+1..=c1, are
+                // touched only by strip k; strips are disjoint column ranges.
+                unsafe {
+                    let prev = base.0.add(r * w1);
+                    let cur = base.0.add((r + 1) * w1);
+                    for c in c0..c1 {
+                        acc += lut[rrow[c] as usize];
+                        *cur.add(c + 1) = *prev.add(c + 1) + acc;
+                    }
+                }
+            }
+        });
     }
 
     /// Running sum down each column, in fixed column strips.
@@ -157,59 +193,106 @@ impl Sat {
         Ok(if n == 0 { f64::NAN } else { s / n as f64 })
     }
 
+    /// One row `r` of the sliding-window REV mean (see [`Sat::rev_mean_into`]).
+    fn rev_row(&self, r: usize, side: usize, need: usize, orow: &mut [f64]) {
+        let (h, w) = self.dim();
+        let lo = side / 2;
+        let hi = side - lo;
+        // Columns whose window is not clipped: c - lo >= 0 and c + hi <= w.
+        let (ci0, ci1) = (lo, (w + 1).saturating_sub(hi).max(lo));
+        let r0 = r.saturating_sub(lo);
+        let r1 = (r + hi).min(h);
+        let slow = |c: usize| {
+            let c0 = c.saturating_sub(lo);
+            let c1 = (c + hi).min(w);
+            let (s, n) = self.window(r0, c0, r1, c1);
+            if n >= need { s / n as f64 } else { f64::NAN }
+        };
+        let rows = (self.s.row(r0).to_slice(), self.s.row(r1).to_slice());
+        let (Some(top), Some(bot), None) = (rows.0, rows.1, &self.count) else {
+            for (c, o) in orow.iter_mut().enumerate() {
+                *o = slow(c);
+            }
+            return;
+        };
+        let n = (r1 - r0) * side;
+        if n >= need && ci1 > ci0 {
+            let inv = 1.0 / n as f64;
+            let len = ci1 - ci0;
+            let (tl, bl_) = (&top[..len], &bot[..len]);
+            let (tr, br) = (&top[side..side + len], &bot[side..side + len]);
+            for ((((o, &a), &b), &c), &d) in orow[ci0..ci1].iter_mut().zip(br).zip(tr).zip(bl_).zip(tl) {
+                *o = (a - b - c + d) * inv;
+            }
+        } else {
+            for (c, o) in orow.iter_mut().enumerate().take(ci1).skip(ci0) {
+                *o = slow(c);
+            }
+        }
+        for c in (0..ci0).chain(ci1..w) {
+            orow[c] = slow(c);
+        }
+    }
+
     /// Sliding-window REV mean centred on every pixel (window rows `r - side/2 ..
     /// r - side/2 + side`, clipped to the image) into `out`. Interior columns of an
     /// unmasked table take a branch-free, vectorisable loop over contiguous rows.
     pub fn rev_mean_into(&self, side: usize, min_valid: f64, out: &mut Array2<f64>) -> Result<()> {
         let (h, w) = self.dim();
         check_side(side, h, w)?;
-        if out.dim() != (h, w) {
+        if out.dim() != (h, w) || !out.is_standard_layout() {
             *out = Array2::zeros((h, w));
         }
         let need = (min_valid * (side * side) as f64).ceil().max(1.0) as usize;
-        let lo = side / 2;
-        let hi = side - lo;
-        // Columns whose window is not clipped: c - lo >= 0 and c + hi <= w.
-        let (ci0, ci1) = (lo, (w + 1).saturating_sub(hi).max(lo));
-        let fast = self.count.is_none() && self.s.is_standard_layout();
         out.axis_iter_mut(Axis(0))
             .into_par_iter()
             .enumerate()
             .for_each(|(r, mut orow)| {
-                let r0 = r.saturating_sub(lo);
-                let r1 = (r + hi).min(h);
-                let slow = |c: usize| {
-                    let c0 = c.saturating_sub(lo);
-                    let c1 = (c + hi).min(w);
-                    let (s, n) = self.window(r0, c0, r1, c1);
-                    if n >= need { s / n as f64 } else { f64::NAN }
-                };
-                let (Some(orow_s), true) = (orow.as_slice_mut(), fast) else {
-                    for (c, o) in orow.iter_mut().enumerate() {
-                        *o = slow(c);
-                    }
-                    return;
-                };
-                let n = (r1 - r0) * side;
-                let top = self.s.row(r0).to_slice().expect("standard layout");
-                let bot = self.s.row(r1).to_slice().expect("standard layout");
-                if n >= need && ci1 > ci0 {
-                    let inv = 1.0 / n as f64;
-                    let len = ci1 - ci0;
-                    let (tl, bl_) = (&top[..len], &bot[..len]);
-                    let (tr, br) = (&top[side..side + len], &bot[side..side + len]);
-                    for ((((o, &a), &b), &c), &d) in
-                        orow_s[ci0..ci1].iter_mut().zip(br).zip(tr).zip(bl_).zip(tl)
-                    {
-                        *o = (a - b - c + d) * inv;
-                    }
-                } else {
-                    for (c, o) in orow_s.iter_mut().enumerate().take(ci1).skip(ci0) {
-                        *o = slow(c);
-                    }
-                }
-                for c in (0..ci0).chain(ci1..w) {
-                    orow_s[c] = slow(c);
+                self.rev_row(r, side, need, orow.as_slice_mut().expect("standard layout"));
+            });
+        Ok(())
+    }
+
+    /// [`Sat::rev_mean_into`] fused with Eq. (5): each REV row is turned into
+    /// `eps_vol = g0 / g - 1` while still in cache (NaN where `g0 < min_gs`), saving a pass.
+    pub fn rev_mean_eps_into(
+        &self,
+        side: usize,
+        min_valid: f64,
+        g0: ArrayView2<f64>,
+        min_gs: f64,
+        out: &mut Array2<f64>,
+        eps: &mut Array2<f64>,
+    ) -> Result<()> {
+        let (h, w) = self.dim();
+        check_side(side, h, w)?;
+        for a in [&mut *out, &mut *eps] {
+            if a.dim() != (h, w) || !a.is_standard_layout() {
+                *a = Array2::zeros((h, w));
+            }
+        }
+        if g0.dim() != (h, w) {
+            return Err(ImagingError::invalid(
+                "g0",
+                format!("{:?}", g0.dim()),
+                "must match the frame size",
+            ));
+        }
+        let need = (min_valid * (side * side) as f64).ceil().max(1.0) as usize;
+        out.axis_iter_mut(Axis(0))
+            .into_par_iter()
+            .zip(eps.axis_iter_mut(Axis(0)).into_par_iter())
+            .zip(g0.axis_iter(Axis(0)).into_par_iter())
+            .enumerate()
+            .for_each(|(r, ((mut orow, mut erow), grow))| {
+                let o = orow.as_slice_mut().expect("standard layout");
+                self.rev_row(r, side, need, o);
+                for ((e, &g), &a) in erow.iter_mut().zip(o.iter()).zip(grow) {
+                    *e = if a >= min_gs {
+                        crate::beer_lambert::eps_vol(a, g)
+                    } else {
+                        f64::NAN
+                    };
                 }
             });
         Ok(())
@@ -321,6 +404,47 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn u16_strip_pass_matches_float_build() {
+        let raw = Array2::from_shape_fn((23, 600), |(r, c)| (100 + (r * 131 + c * 17) % 5000) as u16);
+        let lut: Vec<f64> = (0..=u16::MAX as u32).map(|c| (c.max(1) as f64).ln()).collect();
+        let f = raw.mapv(|c| lut[c as usize]);
+        let (mut a, mut b) = (Sat::new(), Sat::new());
+        a.build_u16(raw.view(), &lut);
+        b.build(f.view());
+        let (ra, rb) = (a.rev_mean(9, 0.5).unwrap(), b.rev_mean(9, 0.5).unwrap());
+        // Corner windows hold too few pixels for min_valid and are NaN in both.
+        let same = |x: f64, y: f64| (x.is_nan() && y.is_nan()) || (x - y).abs() < 1e-9;
+        assert!(ra.iter().zip(&rb).all(|(x, y)| same(*x, *y)));
+        assert!(ra.iter().filter(|v| v.is_finite()).count() > ra.len() / 2);
+        // Reusing the table gives the same bits.
+        a.build_u16(raw.view(), &lut);
+        assert!(
+            a.rev_mean(9, 0.5)
+                .unwrap()
+                .iter()
+                .zip(&ra)
+                .all(|(x, y)| x.to_bits() == y.to_bits())
+        );
+    }
+
+    #[test]
+    fn fused_eps_matches_separate_passes() {
+        let f0 = Array2::from_shape_fn((30, 70), |(r, c)| 0.3 + ((r * 3 + c * 7) % 11) as f64 * 0.03);
+        let f1 = f0.mapv(|v| v * 0.97 + 0.01);
+        let mut sat = Sat::new();
+        sat.build(f0.view());
+        let g0 = sat.rev_mean(7, 0.5).unwrap();
+        sat.build(f1.view());
+        let g1 = sat.rev_mean(7, 0.5).unwrap();
+        let (mut g, mut e) = (Array2::zeros((0, 0)), Array2::zeros((0, 0)));
+        sat.rev_mean_eps_into(7, 0.5, g0.view(), 0.1, &mut g, &mut e)
+            .unwrap();
+        let e_ref = crate::beer_lambert::eps_vol_field(g0.view(), g1.view(), 0.1);
+        assert!(g.iter().zip(&g1).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(e.iter().zip(&e_ref).all(|(a, b)| a.to_bits() == b.to_bits()));
     }
 
     #[test]
