@@ -86,7 +86,8 @@ impl Params {
                 "0.45 splits touching grains",
             ));
         }
-        if !(self.round_aspect >= 1.0) {
+        // Written to reject NaN too.
+        if self.round_aspect.is_nan() || self.round_aspect < 1.0 {
             return Err(bad(
                 "round_aspect",
                 self.round_aspect,

@@ -117,7 +117,7 @@ mod tests {
 
     #[test]
     fn uniform_is_an_error() {
-        let v = vec![0.5; 10];
+        let v = [0.5; 10];
         assert!(matches!(
             otsu(v.iter().copied()),
             Err(GrainsError::UniformImage { .. })

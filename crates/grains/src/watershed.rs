@@ -94,9 +94,9 @@ pub fn watershed(sqdist: &Array2<f64>, p: WatershedParams) -> (Array2<u32>, usiz
         parent[i as usize] = main;
         // Every other basin met here: this pixel is a saddle between it and `main`. The
         // shallower of the two is merged into the deeper when its dynamic is small.
-        for k in 0..roots.len() {
+        for &root in &roots {
             let a = find(&mut parent, main);
-            let b = find(&mut parent, roots[k]);
+            let b = find(&mut parent, root);
             if a == b {
                 continue;
             }
