@@ -101,6 +101,26 @@ pub struct Table {
     pub caption: String,
 }
 
+/// Plot `field` as `dir/file`, and record it as a figure (with `caption`) and an output
+/// file: the bookkeeping every map a stage makes needs.
+pub fn field_figure(
+    dir: &Path,
+    file: String,
+    field: ndarray::ArrayView2<f64>,
+    opts: &crate::report::plot::FieldPlot,
+    caption: String,
+    figures: &mut Vec<Figure>,
+    files: &mut Vec<PathBuf>,
+) -> Result<()> {
+    crate::report::plot::field_png(&dir.join(&file), field, opts)?;
+    figures.push(Figure {
+        path: PathBuf::from(&file),
+        caption,
+    });
+    files.push(file.into());
+    Ok(())
+}
+
 /// What a stage returns; the runner stores it in the stage's `stage.json` manifest.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct StageOutput {

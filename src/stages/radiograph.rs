@@ -494,8 +494,9 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
             eps_tiles = Some(bl::eps_vol_field(g0t.view(), gs_tiles.view(), p.eps_min_gs));
             if png_frame(n) {
                 let f = format!("{ename}.png");
-                plot::field_png(
-                    &out.join(&f),
+                super::field_figure(
+                    out,
+                    f,
                     eps.view(),
                     &plot::FieldPlot {
                         title: &format!("eps_vol, frame {n} (Eq. 5)"),
@@ -504,22 +505,21 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
                         range: None,
                         pixel_size: Some(p.pixel_size),
                     },
-                )?;
-                figures.push(Figure {
-                    path: f.clone().into(),
-                    caption: format!(
+                    format!(
                         "Volumetric strain eps_vol = g_S.REV^0 / g_S.REV^{n} - 1 (Eq. 5) of frame {n} ({}); \
                          positive = dilation. REV {} px.",
                         pr.labels[n], pr.rev_side
                     ),
-                });
-                files.push(f.into());
+                    &mut figures,
+                    &mut files,
+                )?;
             }
         }
         if png_frame(n) {
             let f = format!("{gname}.png");
-            plot::field_png(
-                &out.join(&f),
+            super::field_figure(
+                out,
+                f,
                 gmap.view(),
                 &plot::FieldPlot {
                     title: &format!("g_S.REV, frame {n}"),
@@ -528,18 +528,16 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
                     range: None,
                     pixel_size: Some(p.pixel_size),
                 },
-            )?;
-            figures.push(Figure {
-                path: f.clone().into(),
-                caption: format!(
+                format!(
                     "REV-averaged solid fraction g_S.REV of frame {n} ({}), Eq. ({}), REV side {} px = {:.3} x d_bar.",
                     pr.labels[n],
                     if n == 0 { "1" } else { "4b" },
                     pr.rev_side,
                     p.rev_factor
                 ),
-            });
-            files.push(f.into());
+                &mut figures,
+                &mut files,
+            )?;
         }
         let mut profs = Vec::new();
         for spec in &p.profiles {

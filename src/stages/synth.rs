@@ -13,7 +13,7 @@
 //! the defaults (solid alpha-Al 2700 kg/m^3 with no Cu, as REFERENCES.md; liquid
 //! Al-33wt%Cu at 3400 kg/m^3) are illustrative assumptions, not measured values.
 
-use super::{Figure, Stage, StageContext, StageOutput};
+use super::{Stage, StageContext, StageOutput};
 use crate::io::tiff as tio;
 use crate::report::{plot, table};
 use anyhow::{Context, Result, bail};
@@ -357,8 +357,9 @@ impl Stage for SynthRadiograph {
                 files.push(format!("true_eps_vol_{k:03}.tif").into());
                 if p.plots && k + 1 == p.frames {
                     let f = format!("true_eps_vol_{k:03}.png");
-                    plot::field_png(
-                        &out.join(&f),
+                    super::field_figure(
+                        out,
+                        f,
                         eps.view(),
                         &plot::FieldPlot {
                             title: &format!("True eps_vol, frame {k}"),
@@ -367,12 +368,12 @@ impl Stage for SynthRadiograph {
                             range: None,
                             pixel_size: Some(p.pixel_size),
                         },
+                        format!(
+                            "Prescribed (true) volumetric strain of synthetic frame {k} (Eq. 5 on the true REV maps)."
+                        ),
+                        &mut figures,
+                        &mut files,
                     )?;
-                    figures.push(Figure {
-                        path: f.clone().into(),
-                        caption: format!("Prescribed (true) volumetric strain of synthetic frame {k} (Eq. 5 on the true REV maps)."),
-                    });
-                    files.push(f.into());
                 }
             }
             let xs: Vec<f64> = disks.iter().map(|d| d.x).collect();
@@ -384,8 +385,9 @@ impl Stage for SynthRadiograph {
             if p.plots && (k == 0 || k + 1 == p.frames) {
                 let f = format!("frame_{k:03}.png");
                 let ff = frame.mapv(f64::from);
-                plot::field_png(
-                    &out.join(&f),
+                super::field_figure(
+                    out,
+                    f,
                     ff.view(),
                     &plot::FieldPlot {
                         title: &format!("Synthetic radiograph, frame {k}"),
@@ -394,18 +396,16 @@ impl Stage for SynthRadiograph {
                         range: None,
                         pixel_size: Some(p.pixel_size),
                     },
-                )?;
-                figures.push(Figure {
-                    path: f.clone().into(),
-                    caption: format!(
+                    format!(
                         "Synthetic 16-bit radiograph {k}: solid pad (top), disk assembly, liquid pad (bottom); \
                          L = {:.1} um, blur {} px, Poisson noise {}.",
                         thickness * 1e6,
                         p.blur_sigma_px,
                         p.noise
                     ),
-                });
-                files.push(f.into());
+                    &mut figures,
+                    &mut files,
+                )?;
             }
             per_frame.push(json!({
                 "frame": k,
