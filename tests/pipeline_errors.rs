@@ -1,18 +1,8 @@
 //! Bad pipeline files fail with the file and the offending name in the message, before
 //! anything is written.
 
-use std::process::Command;
-
-fn run(args: &[&str]) -> (bool, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_lbdem"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
+mod common;
+use common::run;
 
 #[test]
 fn bad_pipeline_is_named_and_writes_nothing() {

@@ -4,7 +4,8 @@
 //! temporary directory so the test never writes into the repository.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+use common::run;
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -20,17 +21,6 @@ fn redirected_pipeline(dir: &Path, out: &Path) -> PathBuf {
     let path = dir.join("quickstart.toml");
     std::fs::write(&path, toml::to_string(&doc).unwrap()).unwrap();
     path
-}
-
-fn run(args: &[&str]) -> (bool, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_lbdem"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
 }
 
 #[test]
