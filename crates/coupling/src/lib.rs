@@ -1,10 +1,24 @@
 //! LBM-DEM coupling by partially saturated cells (Noble & Torczynski 1998; Su et al.
-//! 2020 Eqs. 9-14). This crate holds the geometry and weighting that do not depend on
-//! either engine's data layout: the exact overlap of lattice cells with circles, the
-//! per-cell solid fraction of a set of clumped grains, and the weighting B of Eq. 10.
-//! The collision term (Eq. 11) and the force and moment sums (Eq. 14) come with the
-//! engines' coupling (issue 6).
+//! 2020 Eqs. 9-14), and the moving-boundary bounce-back alternative (Leonardi et al. 2014
+//! Eqs. 19-21) for comparison on the same cases.
+//!
+//! - geometry: the exact overlap of lattice cells with circles ([`overlap`]) and the per-cell
+//!   solid fraction of clumped grains with the hydrodynamic radius r_hd ([`solid_fraction`]);
+//! - the weighting B of Eq. 10 ([`weighting`]);
+//! - the PSM lattice: collision of Eqs. 9 and 11, force and moment of Eq. 14 ([`psm`]);
+//! - the sub-cycling driver that holds the hydrodynamic load over the DEM steps ([`driver`]).
 
+// Kernels index several parallel arrays (velocities, weights, populations) by direction: an index
+// loop says that more plainly than zipped iterators.
+#![allow(clippy::needless_range_loop)]
+
+pub mod driver;
+pub mod error;
 pub mod overlap;
+pub mod psm;
 pub mod solid_fraction;
+pub mod units;
 pub mod weighting;
+
+pub use error::CouplingError;
+pub use psm::{GrainMotion, Load, PsmFluid, PsmSettings};

@@ -1,0 +1,189 @@
+//! The coupled time loop of Su et al. 2020 Fig. 2: one LBM cycle, then `ratio` DEM cycles with
+//! the hydrodynamic force and moment of that LBM cycle held fixed (Table 3: r = δt/Δt).
+//!
+//! The held load replaces the previous one in the DEM's stored total force as well, so the
+//! first half-kick of velocity Verlet already uses it: the impulse the grains receive over the
+//! sub-cycles is exactly F δt, the momentum the fluid lost in the LBM step.
+
+use crate::error::CouplingError;
+use crate::psm::{GrainMotion, Load, PsmFluid};
+use crate::solid_fraction::{GrainCircle, SolidMap, solid_map};
+use crate::units::CouplingUnits;
+use lbdem_dem::{Law, StepParams, Stepper, System, Vec2};
+use lbdem_lbm::Real;
+use std::time::{Duration, Instant};
+
+/// Wall-clock time spent in each part of the loop.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Timing {
+    pub lbm: Duration,
+    pub dem: Duration,
+    /// Solid map, grain motions, load conversion.
+    pub coupling: Duration,
+}
+
+/// A coupled LBM-DEM run: the lattice, the grains and the scratch of both engines.
+pub struct Coupled<T: Real> {
+    pub fluid: PsmFluid<T>,
+    pub sys: System,
+    pub law: Law,
+    pub wall_law: Law,
+    /// DEM step parameters (`dt` = the DEM time step of `units`).
+    pub params: StepParams,
+    pub units: CouplingUnits,
+    /// Hydrodynamic radius factor, LBM step only (Su Sect. 2.3: 0.8 in 2D).
+    pub r_hd: f64,
+    /// Bodies that do not feel the fluid (e.g. the membrane ring), by body index.
+    pub dry: Vec<bool>,
+    /// Forces and moments other than the fluid's (drivers), added to the held load.
+    pub user_force: Vec<Vec2>,
+    pub user_torque: Vec<f64>,
+    /// Load of the last LBM cycle on each body (SI: N/m and N m/m).
+    pub hydro: Vec<Load>,
+    pub timing: Timing,
+    dem: Stepper,
+    map: SolidMap,
+    motions: Vec<GrainMotion>,
+    circles: Vec<GrainCircle>,
+    loads: Vec<Load>,
+}
+
+impl<T: Real> Coupled<T> {
+    pub fn new(
+        fluid: PsmFluid<T>,
+        sys: System,
+        law: Law,
+        wall_law: Law,
+        params: StepParams,
+        units: CouplingUnits,
+        r_hd: f64,
+    ) -> Result<Self, CouplingError> {
+        if (params.dt - units.dt_dem).abs() > 1e-12 * units.dt_dem {
+            return Err(CouplingError::Unsupported(format!(
+                "DEM step {} s differs from the coupling units' {} s",
+                params.dt, units.dt_dem
+            )));
+        }
+        if !(r_hd > 0.0 && r_hd <= 1.0) {
+            return Err(CouplingError::Unsupported(format!(
+                "hydrodynamic radius factor r_hd = {r_hd} must be in (0, 1] (Su et al. use 0.8)"
+            )));
+        }
+        let n = sys.bodies.len();
+        Ok(Self {
+            fluid,
+            law,
+            wall_law,
+            params,
+            units,
+            r_hd,
+            dry: vec![false; n],
+            user_force: sys.bodies.ext_force.clone(),
+            user_torque: sys.bodies.ext_torque.clone(),
+            hydro: vec![Load::default(); n],
+            sys,
+            timing: Timing::default(),
+            dem: Stepper::new(),
+            map: SolidMap {
+                nx: 0,
+                ny: 0,
+                covers: Vec::new(),
+                total: Vec::new(),
+            },
+            motions: Vec::new(),
+            circles: Vec::new(),
+            loads: Vec::new(),
+        })
+    }
+
+    /// The solid map of the last LBM cycle.
+    pub fn solid_map(&self) -> &SolidMap {
+        &self.map
+    }
+
+    /// Grain motions and circles in lattice units, then the solid fraction of every cell.
+    fn map_grains(&mut self) {
+        let b = &self.sys.bodies;
+        let u = &self.units;
+        self.motions.clear();
+        self.circles.clear();
+        for k in 0..b.len() {
+            let p = u.position_to_lattice([b.pos[k].x, b.pos[k].y]);
+            self.motions.push(GrainMotion {
+                centre: p,
+                velocity: u.velocity_to_lattice([b.vel[k].x, b.vel[k].y]),
+                omega: u.omega_to_lattice(b.omega[k]),
+            });
+            if self.dry[k] {
+                continue;
+            }
+            for c in b.circle_start[k]..b.circle_start[k + 1] {
+                let off = b.circle_offset[c].rotated(b.angle[k]);
+                let cp = u.position_to_lattice([b.pos[k].x + off.x, b.pos[k].y + off.y]);
+                self.circles.push(GrainCircle {
+                    body: k as u32,
+                    centre: cp,
+                    radius: u.length_to_lattice(b.circle_r[c]),
+                });
+            }
+        }
+        let periodic = self.sys.domain.periodic;
+        self.map = solid_map(
+            &self.circles,
+            self.r_hd,
+            self.fluid.nx,
+            self.fluid.ny,
+            [periodic[0], periodic[1]],
+        );
+    }
+
+    /// One LBM cycle and `ratio` DEM cycles.
+    pub fn step(&mut self) -> Result<(), CouplingError> {
+        let t0 = Instant::now();
+        self.map_grains();
+        let t1 = Instant::now();
+        self.fluid.step(&self.map, &self.motions, &mut self.loads)?;
+        let t2 = Instant::now();
+        let b = &mut self.sys.bodies;
+        for k in 0..b.len() {
+            let l = &self.loads[k];
+            let f = self.units.force_to_si(l.force);
+            let t = self.units.torque_to_si(l.torque);
+            self.hydro[k] = Load { force: f, torque: t };
+            let new_f = self.user_force[k] + Vec2::new(f[0], f[1]);
+            let new_t = self.user_torque[k] + t;
+            // Swap the held load in the stored total too (see the module note).
+            b.force[k] += new_f - b.ext_force[k];
+            b.torque[k] += new_t - b.ext_torque[k];
+            b.ext_force[k] = new_f;
+            b.ext_torque[k] = new_t;
+        }
+        let t3 = Instant::now();
+        for _ in 0..self.units.ratio {
+            self.dem
+                .step_law(&self.params, &self.law, &self.wall_law, &mut self.sys)?;
+        }
+        let t4 = Instant::now();
+        self.timing.coupling += (t1 - t0) + (t3 - t2);
+        self.timing.lbm += t2 - t1;
+        self.timing.dem += t4 - t3;
+        Ok(())
+    }
+
+    /// Total momentum of fluid and grains (SI, per metre of depth).
+    pub fn momentum(&self) -> [f64; 2] {
+        let (_, j) = self.fluid.mass_momentum();
+        let mut p = self.units.momentum_to_si(j);
+        let b = &self.sys.bodies;
+        for k in 0..b.len() {
+            p[0] += b.mass[k] * b.vel[k].x;
+            p[1] += b.mass[k] * b.vel[k].y;
+        }
+        p
+    }
+
+    /// Number of DEM contacts at the last force evaluation.
+    pub fn n_contacts(&self) -> usize {
+        self.dem.n_contacts()
+    }
+}

@@ -1,0 +1,111 @@
+//! SI <-> lattice units of a coupled run: the LBM units of `lbdem_core::units::lattice` (Su
+//! Eqs. 15-16) plus the DEM time step and the integer LBM-DEM time-step ratio of Su et al.
+//! 2020 Table 3 (r = δt / Δt DEM cycles per LBM cycle).
+
+use crate::error::CouplingError;
+use lbdem_core::units::lattice::LatticeUnits;
+
+/// How positions, velocities and loads convert between the DEM (SI, 2D per metre of depth)
+/// and the lattice. The lattice node (i, j) has its centre at `origin + (i + ½, j + ½) dx`.
+#[derive(Clone, Debug)]
+pub struct CouplingUnits {
+    pub lattice: LatticeUnits,
+    pub origin: [f64; 2],
+    /// DEM time step (s).
+    pub dt_dem: f64,
+    /// DEM sub-steps per LBM step.
+    pub ratio: u32,
+}
+
+impl CouplingUnits {
+    /// Check that `lattice.dt / dt_dem` is a whole number (to 1e-9 relative) of at least 1.
+    pub fn new(lattice: LatticeUnits, origin: [f64; 2], dt_dem: f64) -> Result<Self, CouplingError> {
+        let r = lattice.dt / dt_dem;
+        let whole = r.round();
+        if !(r.is_finite() && whole >= 1.0 && (r - whole).abs() <= 1e-9 * whole) {
+            return Err(CouplingError::Ratio { ratio: r });
+        }
+        Ok(Self {
+            lattice,
+            origin,
+            dt_dem,
+            ratio: whole as u32,
+        })
+    }
+    pub fn dx(&self) -> f64 {
+        self.lattice.dx
+    }
+    pub fn dt(&self) -> f64 {
+        self.lattice.dt
+    }
+    /// SI position -> lattice coordinates (cell (i, j) spans [i, i + 1] x [j, j + 1]).
+    pub fn position_to_lattice(&self, p: [f64; 2]) -> [f64; 2] {
+        [
+            (p[0] - self.origin[0]) / self.dx(),
+            (p[1] - self.origin[1]) / self.dx(),
+        ]
+    }
+    pub fn length_to_lattice(&self, l: f64) -> f64 {
+        l / self.dx()
+    }
+    pub fn velocity_to_lattice(&self, v: [f64; 2]) -> [f64; 2] {
+        let s = self.dt() / self.dx();
+        [v[0] * s, v[1] * s]
+    }
+    pub fn omega_to_lattice(&self, w: f64) -> f64 {
+        w * self.dt()
+    }
+    /// Lattice force -> N per metre of depth (ρ dx³/dt²).
+    pub fn force_to_si(&self, f: [f64; 2]) -> [f64; 2] {
+        [
+            self.lattice.force_to_si(f[0], 2),
+            self.lattice.force_to_si(f[1], 2),
+        ]
+    }
+    /// Lattice moment -> N m per metre of depth.
+    pub fn torque_to_si(&self, t: f64) -> f64 {
+        self.lattice.torque_to_si(t, 2)
+    }
+    /// Lattice momentum -> kg m/s per metre of depth (ρ dx³/dt).
+    pub fn momentum_to_si(&self, j: [f64; 2]) -> [f64; 2] {
+        let s = self.lattice.rho * self.dx().powi(3) / self.dt();
+        [j[0] * s, j[1] * s]
+    }
+    /// Lattice pressure change (Δρ c_s²) -> Pa (Su Eq. 19).
+    pub fn pressure_to_si(&self, p: f64) -> f64 {
+        p * self.lattice.rho * self.dx() * self.dx() / (self.dt() * self.dt())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lbdem_core::units::lattice::{LatticeInput, TimeSpec};
+
+    fn lattice(dt: f64) -> LatticeUnits {
+        // Su et al. 2020 Table 3, 30 µm/s runs: dx = 40 µm, δt = 6.66e-4 s, ν ≈ 6e-7 m²/s.
+        LatticeUnits::derive(&LatticeInput::new(40e-6, 6.0e-7, 2700.0, 1e-3, TimeSpec::Dt(dt))).unwrap()
+    }
+
+    #[test]
+    fn ratio_must_be_whole() {
+        let u = CouplingUnits::new(lattice(6.66e-4), [0.0; 2], 6.66e-6).unwrap();
+        assert_eq!(u.ratio, 100);
+        let e = CouplingUnits::new(lattice(6.66e-4), [0.0; 2], 7e-6).unwrap_err();
+        assert!(e.to_string().contains("95.14"), "{e}");
+        assert!(CouplingUnits::new(lattice(6.66e-4), [0.0; 2], 1e-3).is_err());
+    }
+
+    #[test]
+    fn momentum_and_impulse_agree() {
+        // An LBM step moves lattice momentum j; the grains receive F dt_lbm: same SI figure.
+        let u = CouplingUnits::new(lattice(6.66e-4), [1.0, 2.0], 6.66e-6).unwrap();
+        let j = [0.3, -0.2];
+        let f = u.force_to_si(j);
+        let p = u.momentum_to_si(j);
+        for a in 0..2 {
+            approx::assert_relative_eq!(f[a] * u.dt(), p[a], max_relative = 1e-14);
+        }
+        assert_eq!(u.position_to_lattice([1.0 + 40e-6, 2.0]), [1.0, 0.0]);
+    }
+}

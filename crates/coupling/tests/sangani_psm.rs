@@ -1,0 +1,81 @@
+//! Stokes drag on a periodic square array of fixed cylinders resolved by partially saturated
+//! cells, against Sangani & Acrivos, Int. J. Multiphase Flow 8 (1982) 193, Table 1
+//! (REFERENCES.md): F/(μU) = 24.83, 51.53, 102.90 at Φ = 0.1, 0.2, 0.3, with F the drag per unit
+//! length and U the superficial velocity. A body force g on every node plays the mean pressure
+//! gradient G. The force acts on the liquid share 1 − B of each node, so in steady state the Eq. 14
+//! force on the cylinder must equal g Σ(1 − B) (all the momentum put in ends on the cylinder), and
+//! F/(μU) = g L² / (ν U) at ρ = 1 (F = G L² includes the pressure's share on the solid area).
+
+mod common;
+use common::*;
+use lbdem_coupling::PsmFluid;
+use lbdem_coupling::solid_fraction::GrainCircle;
+use lbdem_coupling::weighting::psm_weight;
+use lbdem_lbm::Domain;
+
+const TABLE: [(f64, f64); 3] = [(0.10, 24.83), (0.20, 51.53), (0.30, 102.90)];
+
+/// (F/(μU) measured with U from the fluid, Eq. 14 drag over g L²).
+fn drag(l: usize, phi: f64, tau: f64) -> (f64, f64) {
+    let c = l as f64 / 2.0;
+    let r = l as f64 * (phi / std::f64::consts::PI).sqrt();
+    let circles = [GrainCircle {
+        body: 0,
+        centre: [c, c],
+        radius: r,
+    }];
+    let (map, motions) = fixed(&circles, l, l, [true, true]);
+    let g = 1e-6;
+    let mut fluid = PsmFluid::<f64>::new(&Domain::periodic([l, l, 1]), settings(tau, [g, 0.0])).unwrap();
+    let (loads, _) = run_steady(&mut fluid, &map, &motions, 500, 1e-8, 200_000);
+    let nu = (tau - 0.5) / 3.0;
+    let u = mean_u(&fluid)[0];
+    let total = g * (l * l) as f64;
+    let liquid: f64 = map.total.iter().map(|&e| 1.0 - psm_weight(e, tau)).sum();
+    (total / (nu * u), loads[0].force[0] / (g * liquid))
+}
+
+/// Errors at `phis` (indices into TABLE); each within `tol`.
+fn check(l: usize, phis: &[usize], tol: f64) -> Vec<f64> {
+    let tau = 1.0;
+    let mut errs = Vec::new();
+    for &k in phis {
+        let (phi, want) = TABLE[k];
+        let (got, balance) = drag(l, phi, tau);
+        let err = (got - want) / want;
+        eprintln!(
+            "PSM L={l} tau={tau} phi={phi}: F/(mu U) = {got:.3}, Sangani-Acrivos {want}, error {:+.2}%, \
+             Eq. 14 drag / g sum(1 - B) = {balance:.6}",
+            100.0 * err
+        );
+        assert!((balance - 1.0).abs() < 1e-4, "force balance {balance}");
+        assert!(err.abs() < tol, "phi {phi}: {got} vs {want}");
+        errs.push(err.abs());
+    }
+    errs
+}
+
+/// About 20 cells per diameter keep PSM drag errors within ~5 % (Yang et al., arXiv 1809.07008,
+/// REFERENCES.md): at L = 32 the diameters are 11-20 cells, at L = 64 twice that, and the error
+/// must fall with resolution.
+#[test]
+fn drag_matches_table_at_two_resolutions() {
+    let coarse = check(32, &[0, 1, 2], 0.07);
+    let fine = check(64, &[1], 0.025);
+    assert!(
+        fine[0] < 0.5 * coarse[1],
+        "no convergence: {coarse:?} -> {fine:?}"
+    );
+}
+
+/// All fractions at both resolutions:
+/// `cargo test --release -p lbdem-coupling --test sangani_psm -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn drag_matches_table_full() {
+    let coarse = check(32, &[0, 1, 2], 0.07);
+    let fine = check(64, &[0, 1, 2], 0.025);
+    for (c, f) in coarse.iter().zip(&fine) {
+        assert!(*f < 0.5 * c, "no convergence: {coarse:?} -> {fine:?}");
+    }
+}
