@@ -1,7 +1,8 @@
 //! Scenes: a simulation set-up in SI units read from a TOML file. The `[scene] kind`
-//! names the physics it uses (`fluid`, `dry`, later `coupled`), and only that physics
+//! names the physics it uses (`fluid`, `dry`, `coupled`), and only that physics
 //! is built: a dry assembly pays nothing for a lattice.
 
+pub mod coupled;
 pub mod dry;
 pub mod fluid;
 
@@ -38,7 +39,7 @@ pub fn run_scene(path: &Path, out: Option<&Path>, resume: bool) -> Result<StageO
         toml::from_str(&text).with_context(|| format!("scene file {} is not valid TOML", path.display()))?;
     let header: Header = value.clone().try_into().with_context(|| {
         format!(
-            "scene file {}: needs a [scene] table with kind = \"fluid\" or \"dry\"",
+            "scene file {}: needs a [scene] table with kind = \"fluid\", \"dry\" or \"coupled\"",
             path.display()
         )
     })?;
@@ -58,8 +59,9 @@ pub fn run_scene(path: &Path, out: Option<&Path>, resume: bool) -> Result<StageO
     match header.scene.kind.as_str() {
         "fluid" => fluid::run(&value, &ctx),
         "dry" => dry::run(&value, &ctx),
+        "coupled" => coupled::run(&value, &ctx),
         other => bail!(
-            "scene file {}: [scene] kind = \"{other}\" is not known; use \"fluid\" or \"dry\"",
+            "scene file {}: [scene] kind = \"{other}\" is not known; use \"fluid\", \"dry\" or \"coupled\"",
             path.display()
         ),
     }

@@ -6,8 +6,9 @@
 //! sub-cycles is exactly F δt, the momentum the fluid lost in the LBM step.
 
 use crate::error::CouplingError;
-use crate::psm::{GrainMotion, Load, PsmFluid};
-use crate::solid_fraction::{GrainCircle, SolidMap, solid_map};
+use crate::hydro::Hydro;
+use crate::psm::{GrainMotion, Load};
+use crate::solid_fraction::GrainCircle;
 use crate::units::CouplingUnits;
 use lbdem_dem::{Law, StepParams, Stepper, System, Vec2};
 use lbdem_lbm::Real;
@@ -24,7 +25,7 @@ pub struct Timing {
 
 /// A coupled LBM-DEM run: the lattice, the grains and the scratch of both engines.
 pub struct Coupled<T: Real> {
-    pub fluid: PsmFluid<T>,
+    pub fluid: Hydro<T>,
     pub sys: System,
     pub law: Law,
     pub wall_law: Law,
@@ -33,16 +34,18 @@ pub struct Coupled<T: Real> {
     pub units: CouplingUnits,
     /// Hydrodynamic radius factor, LBM step only (Su Sect. 2.3: 0.8 in 2D).
     pub r_hd: f64,
+    /// Depth of the 2D sample (m): DEM masses are per this depth (density × area × depth is
+    /// what `Bodies::add` gets as density × area), so the fluid's per-metre loads are scaled by it.
+    pub depth: f64,
     /// Bodies that do not feel the fluid (e.g. the membrane ring), by body index.
     pub dry: Vec<bool>,
     /// Forces and moments other than the fluid's (drivers), added to the held load.
     pub user_force: Vec<Vec2>,
     pub user_torque: Vec<f64>,
-    /// Load of the last LBM cycle on each body (SI: N/m and N m/m).
+    /// Load of the last LBM cycle on each body (SI: N and N m over the depth).
     pub hydro: Vec<Load>,
     pub timing: Timing,
     dem: Stepper,
-    map: SolidMap,
     motions: Vec<GrainMotion>,
     circles: Vec<GrainCircle>,
     loads: Vec<Load>,
@@ -50,7 +53,7 @@ pub struct Coupled<T: Real> {
 
 impl<T: Real> Coupled<T> {
     pub fn new(
-        fluid: PsmFluid<T>,
+        fluid: Hydro<T>,
         sys: System,
         law: Law,
         wall_law: Law,
@@ -77,6 +80,7 @@ impl<T: Real> Coupled<T> {
             params,
             units,
             r_hd,
+            depth: 1.0,
             dry: vec![false; n],
             user_force: sys.bodies.ext_force.clone(),
             user_torque: sys.bodies.ext_torque.clone(),
@@ -84,25 +88,14 @@ impl<T: Real> Coupled<T> {
             sys,
             timing: Timing::default(),
             dem: Stepper::new(),
-            map: SolidMap {
-                nx: 0,
-                ny: 0,
-                covers: Vec::new(),
-                total: Vec::new(),
-            },
             motions: Vec::new(),
             circles: Vec::new(),
             loads: Vec::new(),
         })
     }
 
-    /// The solid map of the last LBM cycle.
-    pub fn solid_map(&self) -> &SolidMap {
-        &self.map
-    }
-
     /// Grain motions and circles in lattice units, then the solid fraction of every cell.
-    fn map_grains(&mut self) {
+    fn map_grains(&mut self) -> Result<(), CouplingError> {
         let b = &self.sys.bodies;
         let u = &self.units;
         self.motions.clear();
@@ -128,27 +121,21 @@ impl<T: Real> Coupled<T> {
             }
         }
         let periodic = self.sys.domain.periodic;
-        self.map = solid_map(
-            &self.circles,
-            self.r_hd,
-            self.fluid.nx,
-            self.fluid.ny,
-            [periodic[0], periodic[1]],
-        );
+        self.fluid.map(&self.circles, &self.motions, self.r_hd, periodic)
     }
 
     /// One LBM cycle and `ratio` DEM cycles.
     pub fn step(&mut self) -> Result<(), CouplingError> {
         let t0 = Instant::now();
-        self.map_grains();
+        self.map_grains()?;
         let t1 = Instant::now();
-        self.fluid.step(&self.map, &self.motions, &mut self.loads)?;
+        self.fluid.step(&self.motions, &mut self.loads)?;
         let t2 = Instant::now();
         let b = &mut self.sys.bodies;
         for k in 0..b.len() {
             let l = &self.loads[k];
-            let f = self.units.force_to_si(l.force);
-            let t = self.units.torque_to_si(l.torque);
+            let f = self.units.force_to_si(l.force).map(|x| x * self.depth);
+            let t = self.units.torque_to_si(l.torque) * self.depth;
             self.hydro[k] = Load { force: f, torque: t };
             let new_f = self.user_force[k] + Vec2::new(f[0], f[1]);
             let new_t = self.user_torque[k] + t;
@@ -170,10 +157,10 @@ impl<T: Real> Coupled<T> {
         Ok(())
     }
 
-    /// Total momentum of fluid and grains (SI, per metre of depth).
+    /// Total momentum of fluid and grains (SI, over the sample's depth).
     pub fn momentum(&self) -> [f64; 2] {
         let (_, j) = self.fluid.mass_momentum();
-        let mut p = self.units.momentum_to_si(j);
+        let mut p = self.units.momentum_to_si(j).map(|x| x * self.depth);
         let b = &self.sys.bodies;
         for k in 0..b.len() {
             p[0] += b.mass[k] * b.vel[k].x;

@@ -12,13 +12,18 @@
 // loop says that more plainly than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bounce;
+pub mod cases;
 pub mod driver;
 pub mod error;
+pub mod hydro;
 pub mod overlap;
 pub mod psm;
 pub mod solid_fraction;
 pub mod units;
 pub mod weighting;
 
+pub use driver::Coupled;
 pub use error::CouplingError;
+pub use hydro::{Hydro, Method};
 pub use psm::{GrainMotion, Load, PsmFluid, PsmSettings};

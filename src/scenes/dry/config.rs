@@ -175,7 +175,29 @@ fn v(a: [f64; 2]) -> Vec2 {
 
 impl DryScene {
     pub fn build_system(&self, base: &Path) -> Result<System> {
-        let pc = &self.particles;
+        build_system(
+            &self.particles,
+            &self.domain,
+            &self.walls,
+            self.bonds.as_ref(),
+            self.membrane.as_ref(),
+            base,
+        )
+    }
+}
+
+/// The DEM system of a scene: particles, box, walls, membrane and its bonds (shared by dry and
+/// coupled scenes).
+pub fn build_system(
+    particles: &ParticlesCfg,
+    domain: &DomainCfg,
+    walls: &[WallCfg],
+    bonds: Option<&BondsCfg>,
+    membrane: Option<&MembraneCfg>,
+    base: &Path,
+) -> Result<System> {
+    {
+        let pc = particles;
         let bodies = match (&pc.csv, &pc.generate) {
             (Some(path), None) => particles::read_csv(&base.join(path), pc.density)?,
             (None, Some(g)) => {
@@ -197,17 +219,17 @@ impl DryScene {
                 generate::random_insert(&shapes, &w, pc.density, v(g.lo), v(g.hi), g.count, g.seed)?
             }
             _ => bail!(
-                "dry scene [particles]: give exactly one of csv = \"FILE.csv\" or a [particles.generate] table"
+                "scene [particles]: give exactly one of csv = \"FILE.csv\" or a [particles.generate] table"
             ),
         };
-        let d = &self.domain;
+        let d = domain;
         let domain = Domain {
             lo: v(d.lo),
             hi: v(d.hi),
             periodic: d.periodic,
         };
         let mut sys = System::new(bodies, domain);
-        for (k, w) in self.walls.iter().enumerate() {
+        for (k, w) in walls.iter().enumerate() {
             let motion = match w.velocity {
                 Some(u) => WallMotion::Velocity { v: v(u) },
                 None => WallMotion::Fixed,
@@ -230,11 +252,11 @@ impl DryScene {
                     .walls
                     .push(Wall::new(WallShape::Segment { a: v(a), b: v(b) }, motion)),
                 _ => bail!(
-                    "dry scene [[walls]] #{k}: give either box = [x0, y0, x1, y1], or p and n (plane), or a and b (segment)"
+                    "scene [[walls]] #{k}: give either box = [x0, y0, x1, y1], or p and n (plane), or a and b (segment)"
                 ),
             }
         }
-        if let Some(m) = &self.membrane {
+        if let Some(m) = membrane {
             let b = &sys.bodies;
             let (lo, hi) = (
                 b.pos.iter().fold(Vec2::new(f64::MAX, f64::MAX), |a, p| {
@@ -257,7 +279,7 @@ impl DryScene {
             for &k in &members {
                 sys.bodies.tag[k as usize] = 1;
             }
-            if let Some(bc) = &self.bonds {
+            if let Some(bc) = bonds {
                 let b = &sys.bodies;
                 for (x, &i) in members.iter().enumerate() {
                     for &j in &members[x + 1..] {

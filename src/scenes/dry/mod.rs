@@ -3,7 +3,7 @@
 //! writes a time series (CSV + JSON), VTK particle snapshots and atomic checkpoints, and
 //! `--resume` continues from the last checkpoint bit for bit. Format: docs/dem.md.
 
-mod config;
+pub(crate) mod config;
 mod particles;
 
 use super::SimContext;
@@ -196,7 +196,7 @@ fn write_series(dir: &Path, rows: &[Row]) -> Result<Vec<PathBuf>> {
 }
 
 /// One point per circle: radius, body id, body velocity and angular velocity.
-fn write_snapshot(path: &Path, sys: &System) -> Result<()> {
+pub(crate) fn write_snapshot(path: &Path, sys: &System) -> Result<()> {
     let b = &sys.bodies;
     let nc = b.n_circles();
     let pos: Vec<[f64; 3]> = (0..nc)
