@@ -183,8 +183,13 @@ fn run_with<T: Real>(cfg: &CoupledScene, ctx: &SimContext) -> Result<StageOutput
     let mut files: Vec<PathBuf> = Vec::new();
     let t0 = std::time::Instant::now();
     for s in 1..=r.steps {
-        pool.install(|| run.step())
-            .map_err(|e| anyhow::anyhow!("coupled scene: {e}; no results written for this run"))?;
+        if let Err(e) = pool.install(|| run.step()) {
+            // Nothing built on an unstable run stays behind.
+            for f in &files {
+                let _ = std::fs::remove_file(ctx.out_dir.join(f));
+            }
+            bail!("coupled scene: {e}; the run's snapshots were removed and no series or summary written");
+        }
         if s % r.output_every == 0 || s == r.steps {
             rows.push(record(&run, s, r.pressure_threshold));
         }
@@ -383,3 +388,6 @@ fn write_fields<T: Real>(path: &Path, run: &Coupled<T>) -> Result<()> {
     )
     .with_context(|| format!("cannot write {}", path.display()))
 }
+
+#[cfg(test)]
+mod tests;
