@@ -3,6 +3,7 @@
 //! and noisy and only ratios taken together mean anything.
 
 pub mod bandwidth;
+pub mod coupled;
 pub mod dem;
 pub mod grains;
 pub mod lbm;
@@ -24,6 +25,8 @@ pub enum Which {
     Dem,
     /// Two-circle grain fitting rate.
     Grains,
+    /// Coupled LBM-DEM steps per second on a shear-cell-sized case.
+    Coupled,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -50,6 +53,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Which::Lbm => lbm::run(a),
         Which::Dem => dem::run(a),
         Which::Grains => grains::run(a),
+        Which::Coupled => coupled::run(a),
     }
 }
 

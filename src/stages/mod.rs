@@ -6,6 +6,7 @@
 pub mod digitise;
 pub mod radiograph;
 pub mod report;
+pub mod settling_study;
 pub mod synth;
 
 use anyhow::{Context, Result, bail};
@@ -189,7 +190,14 @@ fn prepare_as<S: Stage + 'static>(params: toml::Value, ctx: &StageContext) -> Re
 }
 
 /// Every stage kind, for error messages.
-pub const KINDS: &[&str] = &["synth-radiograph", "radiograph", "digitise", "simulate", "report"];
+pub const KINDS: &[&str] = &[
+    "synth-radiograph",
+    "radiograph",
+    "digitise",
+    "simulate",
+    "settling-study",
+    "report",
+];
 
 /// Parse `params` for the stage `kind`.
 pub fn prepare(kind: &str, params: toml::Value, ctx: &StageContext) -> Result<Prepared> {
@@ -198,6 +206,7 @@ pub fn prepare(kind: &str, params: toml::Value, ctx: &StageContext) -> Result<Pr
         "radiograph" => prepare_as::<radiograph::Radiograph>(params, ctx),
         "digitise" => prepare_as::<digitise::Digitise>(params, ctx),
         "simulate" => prepare_as::<crate::scenes::SimulateStage>(params, ctx),
+        "settling-study" => prepare_as::<settling_study::SettlingStudy>(params, ctx),
         "report" => prepare_as::<report::Report>(params, ctx),
         other => bail!("unknown stage kind '{other}'; known kinds: {}", KINDS.join(", ")),
     }
