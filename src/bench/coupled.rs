@@ -17,20 +17,21 @@ use std::time::Instant;
 const DX: f64 = 40e-6;
 const RATIO: u32 = 100;
 
-/// 108 x 65 = 7,020 two-circle grains (circles 42 and 34 µm, 52 µm apart: a 1.3 aspect ratio)
-/// with random orientations on a 92.6 x 116.9 µm grid in a 10 x 7.6 mm walled box (250 x 190
+/// 108 x 65 = 7,020 two-circle grains (circles 36 and 30 µm, 40 µm apart: 106 µm long, a 1.6
+/// aspect ratio), standing within ±0.1 rad of upright on a 92.6 x 116.9 µm grid (packing
+/// fraction about 0.48, no initial overlaps) in a 10 x 7.6 mm walled box (250 x 190
 /// nodes at dx = 40 µm); Al-Cu densities of Su et al. Table 3 (per 1 mm depth).
 fn shear_cell(cols: usize, rows: usize) -> Result<System> {
     let (w, h) = (cols as f64 * 10e-3 / 108.0, rows as f64 * 7.6e-3 / 65.0);
     let shape = ClumpShape {
         balls: vec![
             Ball {
-                centre: Vec2::new(-26e-6, 0.0),
-                r: 42e-6,
+                centre: Vec2::new(-20e-6, 0.0),
+                r: 36e-6,
             },
             Ball {
-                centre: Vec2::new(26e-6, 0.0),
-                r: 34e-6,
+                centre: Vec2::new(20e-6, 0.0),
+                r: 30e-6,
             },
         ],
     };
@@ -46,8 +47,12 @@ fn shear_cell(cols: usize, rows: usize) -> Result<System> {
     for j in 0..rows {
         for i in 0..cols {
             let at = Vec2::new((i as f64 + 0.5) * sx, (j as f64 + 0.5) * sy);
-            // Narrow angles so that neighbours along x do not overlap (grain length 144 µm).
-            let k = b.add(&shape, 2.55, at, 0.25 * (rnd() - 0.5))?;
+            let k = b.add(
+                &shape,
+                2.55,
+                at,
+                std::f64::consts::FRAC_PI_2 + 0.2 * (rnd() - 0.5),
+            )?;
             b.vel[k] = Vec2::new(2e-3 * (rnd() - 0.5), 2e-3 * (rnd() - 0.5));
         }
     }
