@@ -69,6 +69,13 @@ impl Stage for SettlingStudy {
                 p.resolutions
             );
         }
+        if !(p.duration > 0.0 && p.duration.is_finite()) {
+            bail!(
+                "settling-study: duration = {} must be a positive number of viscous times W²/ν (0.6 reaches the \
+                 terminal velocity)",
+                p.duration
+            );
+        }
         for pr in &p.precisions {
             if pr != "f64" && pr != "f32" {
                 bail!("settling-study: precision \"{pr}\" is not known; use \"f64\" or \"f32\"");

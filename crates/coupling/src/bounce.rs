@@ -21,6 +21,8 @@ pub struct BounceFluid<T: Real> {
     stepper: Stepper<D2Q9, T>,
     pub macro_fields: Macro,
     was_solid: Vec<bool>,
+    /// Grain that covered each node before this step's mapping.
+    owner: Vec<u16>,
 }
 
 impl<T: Real> BounceFluid<T> {
@@ -43,6 +45,7 @@ impl<T: Real> BounceFluid<T> {
             stepper,
             macro_fields: Macro::default(),
             was_solid: vec![false; n],
+            owner: vec![NO_OBSTACLE; n],
         })
     }
 
@@ -63,9 +66,15 @@ impl<T: Real> BounceFluid<T> {
         let dom = &mut self.fluid.domain;
         let [nx, ny, _] = dom.n;
         let per = [dom.faces[0].is_periodic(), dom.faces[2].is_periodic()];
+        // Only the grains' own nodes are released (static obstacles of the domain stay); the
+        // grain that covered each node is kept for the refill.
+        let n_grains = motions.len();
         for (i, k) in dom.kind.iter_mut().enumerate() {
-            self.was_solid[i] = *k == SOLID;
-            if *k == SOLID {
+            let grain = dom.obstacle[i];
+            let mine = *k == SOLID && (grain as usize) < n_grains;
+            self.was_solid[i] = mine;
+            self.owner[i] = if mine { grain } else { NO_OBSTACLE };
+            if mine {
                 *k = FLUID;
                 dom.obstacle[i] = NO_OBSTACLE;
             }
@@ -133,17 +142,13 @@ impl<T: Real> BounceFluid<T> {
                 }
             }
             let rho = if cnt > 0 { rho / cnt as f64 } else { 1.0 };
-            // The nearest grain centre owns the node's velocity.
-            let p = [x as f64 + 0.5, y as f64 + 0.5];
-            let u = motions
-                .iter()
-                .map(|m| {
-                    let r = [p[0] - m.centre[0], p[1] - m.centre[1]];
-                    (r[0] * r[0] + r[1] * r[1], m.velocity_at(r))
-                })
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, u)| u)
-                .unwrap_or([0.0; 2]);
+            // The grain that uncovered the node gives its local velocity (minimum image).
+            let m = &motions[self.owner[i] as usize];
+            let r = self.fluid.domain.offset(
+                [m.centre[0] - 0.5, m.centre[1] - 0.5, 0.0],
+                [x as f64, y as f64, 0.0],
+            );
+            let u = m.velocity_at([r[0], r[1]]);
             let feq = equilibrium::<D2Q9>(rho, [u[0], u[1], 0.0]);
             for (q, v) in feq.iter().enumerate().take(D2Q9::Q) {
                 self.fluid.f[q * n + i] = T::from_f64(*v);

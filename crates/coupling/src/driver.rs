@@ -69,7 +69,17 @@ impl<T: Real> Coupled<T> {
         }
         if !(r_hd > 0.0 && r_hd <= 1.0) {
             return Err(CouplingError::Unsupported(format!(
-                "hydrodynamic radius factor r_hd = {r_hd} must be in (0, 1] (Su et al. use 0.8)"
+                "hydrodynamic radius factor r_hd = {r_hd} must be in (0, 1]; set [coupling] r_hd \
+                 (Su et al. use 0.8 in 2D, 1 for validation)"
+            )));
+        }
+        if params.local_damping != 0.0 {
+            // The held-load swap below edits the stored Verlet force after local damping was
+            // applied to it, so the two do not mix.
+            return Err(CouplingError::Unsupported(format!(
+                "[step] local_damping = {} is not supported in coupled runs (the liquid damps the grains); \
+                 remove it or use viscous_damping",
+                params.local_damping
             )));
         }
         let n = sys.bodies.len();

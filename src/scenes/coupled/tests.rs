@@ -115,6 +115,26 @@ fn walk(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
 fn zero_viscosity_is_refused_naming_the_parameter() {
     let dir = tempfile::tempdir().unwrap();
     let v = example(|t| t.replace("dynamic_viscosity = 1.82e-3", "dynamic_viscosity = 0.0"));
-    let e = format!("{:#}", run(&v, &ctx(dir.path())).unwrap_err());
+    let out_dir = dir.path().join("out");
+    let e = format!("{:#}", run(&v, &ctx(&out_dir)).unwrap_err());
     assert!(e.contains("viscosity = 0") && e.contains("[fluid]"), "{e}");
+    assert!(!out_dir.exists());
+}
+
+#[test]
+fn zero_output_interval_and_moving_walls_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let v = example(|t| t.replace("output_every = 50", "output_every = 0"));
+    let e = format!("{:#}", run(&v, &ctx(&out_dir)).unwrap_err());
+    assert!(e.contains("output_every = 0"), "{e}");
+    let v = example(|t| {
+        t.replace(
+            "box = [0.0, 0.0, 0.004, 0.004]",
+            "p = [0.0, 0.004]\nn = [0.0, -1.0]\nvelocity = [0.001, 0.0]",
+        )
+    });
+    let e = format!("{:#}", run(&v, &ctx(&out_dir)).unwrap_err());
+    assert!(e.contains("moving walls"), "{e}");
+    assert!(!out_dir.exists());
 }

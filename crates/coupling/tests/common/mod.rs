@@ -34,7 +34,8 @@ pub fn fixed(
     (map, motions)
 }
 
-/// Run until the mean x velocity changes by less than `tol` (relative) over `every` steps.
+/// Run until the mean x velocity changes by less than `tol` (relative) over `every` steps;
+/// panics if that does not happen within `max_steps`.
 pub fn run_steady(
     fluid: &mut PsmFluid<f64>,
     map: &SolidMap,
@@ -53,11 +54,11 @@ pub fn run_steady(
         steps += every;
         let u = mean_u(fluid)[0];
         if ((u - last) / u).abs() < tol {
-            break;
+            return (loads, steps);
         }
         last = u;
     }
-    (loads, steps)
+    panic!("not steady after {max_steps} steps (mean u changing by more than {tol} per {every} steps)");
 }
 
 /// Mean velocity over every node (the superficial velocity).
