@@ -479,10 +479,11 @@ impl Stepper {
                     (*f, *t) = circle_sum(k);
                 } else {
                     let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
-                    for c in cstart[k]..cstart[k + 1] {
+                    let c0 = cstart[k];
+                    for (c, arm) in (c0..).zip(&carm[c0..cstart[k + 1]]) {
                         let (fc, tc) = circle_sum(c);
                         fb += fc;
-                        tb += tc + carm[c].cross(fc);
+                        tb += tc + arm.cross(fc);
                     }
                     *f = fb;
                     *t = tb;
