@@ -104,6 +104,7 @@ pub struct Stepper {
     all_disks: bool,
     wall_buf: Vec<(Vec2, f64)>,
     n_circles: usize,
+    n_bodies: usize,
     checked_dt: f64,
     pub rebuilds: u64,
 }
@@ -163,7 +164,8 @@ impl Stepper {
         sys: &mut System,
     ) -> Result<(), DemError> {
         let dt = p.dt;
-        if self.checked_dt != dt || self.n_circles != sys.bodies.n_circles() {
+        let shape = (sys.bodies.n_circles(), sys.bodies.len());
+        if self.checked_dt != dt || (self.n_circles, self.n_bodies) != shape {
             let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
             if dt.is_nan() || dt <= 0.0 || dt > crit {
                 return Err(DemError::TimeStepTooLarge {
@@ -174,8 +176,8 @@ impl Stepper {
                 });
             }
             self.checked_dt = dt;
-            let fresh = self.n_circles != sys.bodies.n_circles() || self.ref_pos.is_empty();
-            self.n_circles = sys.bodies.n_circles();
+            let fresh = (self.n_circles, self.n_bodies) != shape || self.ref_pos.is_empty();
+            (self.n_circles, self.n_bodies) = shape;
             if fresh {
                 let b = &sys.bodies;
                 self.all_disks =
