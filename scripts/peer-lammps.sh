@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Run LAMMPS (Debian package `lammps`) on the benchmark case of `lbdem bench dem`: 2D bidisperse
 # disks (d, 1.4d), gran/hooke/history (kn 2e4, kt 2/7 kn, gamma_n 100, mu 0.5), periodic box,
-# packing fraction 0.82, slow pure shear (PEERS.md). Prints LAMMPS's "Loop time" line of the
-# timed run, from which the caller computes particle-steps per second.
+# packing fraction 0.82, slow pure shear (PEERS.md). Prints the last thermo line (step atoms ke phi
+# z press pxy: z = contacts per disk) and the "Loop time" line of the timed run, from which the
+# caller computes particle-steps per second. The first call for a given N_SIDE prepares the packing
+# (lammps_2d_prep.in, 45,000 steps on 2 ranks: ~1 min for 10,000 disks, ~10-20 min for 100,000).
 #
 # Usage: scripts/peer-lammps.sh N_SIDE NP NSTEPS     (N = N_SIDE^2 disks; 100 -> 10,000; 316 -> 99,856)
 # Decks: lammps_2d_prep.in / lammps_2d.in from $LBDEM_PEERS, else ../shared/peers or ../../shared/peers
@@ -37,4 +39,4 @@ if [ ! -f "$rst" ]; then
 fi
 log="$work/run_n${n}_np$np.log"
 run "$np" lmp -log "$log" -screen none -var in "$rst" -var nsteps "$nsteps" -in lammps_2d.in
-grep "Loop time" "$log" | tail -1
+grep -B1 "Loop time" "$log" | tail -2

@@ -2,7 +2,10 @@
 //! bidisperse disks (d, 1.4d), linear spring-dashpot with tangential history (k_n 2e4,
 //! k_t 2/7 k_n, γ_n 100, μ 0.5), periodic box at packing fraction 0.82, slow pure shear
 //! (x stretched at strain rate 0.01, area kept), on 1 and 2 threads; with `--peer`, LAMMPS on
-//! the same case and core count in the same run (scripts/peer-lammps.sh), and the ratio.
+//! the same case and core count in the same run (scripts/peer-lammps.sh), and the ratio. lbdem and
+//! LAMMPS alternate rep by rep; each row also prints LAMMPS's contacts per disk and the load average.
+//! The first `--peer` run prepares and caches the LAMMPS packings in out/peer-lammps/ (the
+//! 100,000-disk one takes 45,000 steps: ~20-40 min on a shared machine).
 
 use super::{BenchArgs, median};
 use anyhow::{Context, Result, bail};
@@ -63,8 +66,8 @@ fn timed(s0: &System, steps: usize, threads: usize) -> Result<(f64, f64)> {
     })
 }
 
-/// LAMMPS rate (particle-steps/s) from scripts/peer-lammps.sh.
-fn peer(n_side: usize, np: usize, steps: usize) -> Result<f64> {
+/// LAMMPS rate (particle-steps/s) and contacts per disk from scripts/peer-lammps.sh.
+fn peer(n_side: usize, np: usize, steps: usize) -> Result<(f64, f64)> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/peer-lammps.sh");
     let out = std::process::Command::new("bash")
         .arg(&script)
@@ -79,16 +82,33 @@ fn peer(n_side: usize, np: usize, steps: usize) -> Result<f64> {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    // "Loop time of T on P procs for S steps with N atoms"
-    let line = text
-        .lines()
-        .rfind(|l| l.starts_with("Loop time"))
+    // "Loop time of T on P procs for S steps with N atoms", preceded by the last thermo line
+    // "step atoms ke phi z press pxy".
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines
+        .iter()
+        .rposition(|l| l.starts_with("Loop time"))
         .context("no 'Loop time' line from LAMMPS")?;
-    let w: Vec<&str> = line.split_whitespace().collect();
+    let w: Vec<&str> = lines[at].split_whitespace().collect();
     let t: f64 = w[3].parse()?;
     let s: f64 = w[8].parse()?;
     let n: f64 = w[11].parse()?;
-    Ok(n * s / t)
+    let z = at
+        .checked_sub(1)
+        .and_then(|k| lines[k].split_whitespace().nth(4))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::NAN);
+    Ok((n * s / t, z))
+}
+
+/// The 1-minute load average (the machine is shared: figures taken under load are depressed).
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -102,46 +122,52 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let mut rows = Vec::new();
     println!(
-        "| case | N | threads | lbdem M p-steps/s (median of {reps}) | z | LAMMPS M p-steps/s | ratio |"
+        "| case | N | threads | lbdem M p-steps/s (median of {reps}) | z | LAMMPS M p-steps/s | LAMMPS z | ratio | load avg |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for (name, n_side, s, steps) in &cases {
         for threads in [1usize, 2] {
-            let mut rates = Vec::new();
-            let mut z = 0.0;
+            // lbdem and LAMMPS alternate rep by rep, so a change of machine load hits both.
+            let lsteps = if *n_side > 100 { 1000 } else { 4000 };
+            if a.peer
+                && !Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join(format!("out/peer-lammps/lmp2d_n{n_side}.restart"))
+                    .exists()
+            {
+                eprintln!("bench dem: preparing the LAMMPS packing for N_SIDE {n_side} once (slow)");
+            }
+            let (mut rates, mut pr) = (Vec::new(), Vec::new());
+            let (mut z, mut zl) = (0.0, f64::NAN);
             for _ in 0..reps {
                 let (r, zz) = timed(s, *steps, threads)?;
                 rates.push(r);
                 z = zz;
+                if a.peer {
+                    let (r, zz) = peer(*n_side, threads, lsteps)?;
+                    pr.push(r);
+                    zl = zz;
+                }
             }
             let ours = median(&rates);
-            // The LAMMPS 100k packing takes ~45,000 steps of 100k disks to prepare; it is used only
-            // if already prepared (scripts/peer-lammps.sh 316 2 2000 prepares it).
-            let peer_ready = *n_side <= 100
-                || Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join(format!("out/peer-lammps/lmp2d_n{n_side}.restart"))
-                    .exists();
-            let (theirs, ratio) = if a.peer && peer_ready {
-                let lsteps = if *n_side > 100 { 1000 } else { 4000 };
-                let mut pr = Vec::new();
-                for _ in 0..reps.min(3) {
-                    pr.push(peer(*n_side, threads, lsteps)?);
-                }
+            let (theirs, zl, ratio) = if a.peer {
                 let t = median(&pr);
-                (Some(t), Some(ours / t))
+                (Some(t), Some(zl), Some(ours / t))
             } else {
-                (None, None)
+                (None, None, None)
             };
             println!(
-                "| {name} | {} | {threads} | {:.2} | {z:.2} | {} | {} |",
+                "| {name} | {} | {threads} | {:.2} | {z:.2} | {} | {} | {} | {} |",
                 s.bodies.len(),
                 ours / 1e6,
                 theirs.map_or("-".into(), |t| format!("{:.2}", t / 1e6)),
-                ratio.map_or("-".into(), |r| format!("{r:.2}"))
+                zl.map_or("-".into(), |z| format!("{z:.2}")),
+                ratio.map_or("-".into(), |r| format!("{r:.2}")),
+                load_average().map_or("-".into(), |l| format!("{l:.1}"))
             );
             rows.push(serde_json::json!({
                 "case": name, "n": s.bodies.len(), "threads": threads, "rate": ours, "rates": rates,
-                "contacts_per_particle": z, "lammps_rate": theirs, "ratio_to_lammps": ratio,
+                "contacts_per_particle": z, "lammps_rate": theirs, "lammps_rates": pr, "lammps_contacts_per_particle": zl,
+                "ratio_to_lammps": ratio, "load_average": load_average(),
             }));
         }
     }

@@ -2,9 +2,12 @@
 //! "Computer Simulation of Liquids", Sect. 3.2), with optional viscous and local (non-viscous,
 //! Cundall) damping. The stepper holds only scratch; all state lives in [`System`].
 //!
-//! Determinism: pair forces are computed per pair in parallel into a per-pair buffer, then each
-//! body gathers its pairs in canonical order; every other reduction runs in a fixed order, so
-//! results are bitwise identical for any number of threads.
+//! Determinism: the pair list is sorted (i < j). One parallel pass over circles i evaluates the
+//! pairs (i, j) in ascending j, sums the force on i in a register and writes the reaction on j
+//! into a per-pair slot; a second pass gives each circle its own sum plus its reaction slots in
+//! ascending i. Pairs that do not touch add nothing (or +0.0, an identity for a sum that starts
+//! at +0.0), so the order, hence every bit, is independent of the thread count and of the step
+//! at which the Verlet list was rebuilt (a resumed run continues bit for bit).
 
 use crate::contact::{ContactInput, ContactLaw, History, Law, LinearSpringDashpot};
 use crate::error::DemError;
@@ -51,16 +54,27 @@ impl StepParams {
     }
 }
 
+/// Reaction of pair (i, j) on circle j: force and torque (zero when the pair does not touch).
 #[derive(Clone, Copy, Debug, Default)]
-struct PairOut {
+struct JOut {
     f: Vec2,
-    ti: f64,
-    tj: f64,
-    touch: bool,
+    t: f64,
 }
+
+/// Sum over the pairs (i, j > i) of circle i: force, torque and number of touching pairs.
+#[derive(Clone, Copy, Debug, Default)]
+struct Acc {
+    f: Vec2,
+    t: f64,
+    n: u32,
+}
+
+/// Circles per parallel task of the pair pass (any value gives the same bits).
+const PAIR_CHUNK: usize = 512;
 
 /// What the pair loop reads of a circle, packed in one cache line.
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
 struct CircleState {
     pos: Vec2,
     /// Velocity of the circle centre.
@@ -78,12 +92,19 @@ pub struct Stepper {
     carm: Vec<Vec2>,
     cstate: Vec<CircleState>,
     ref_pos: Vec<Vec2>,
-    out: Vec<PairOut>,
-    /// Per circle: entries into `out` (pair index << 1 | 1 if the circle is j).
-    csr_start: Vec<u32>,
-    csr: Vec<u32>,
+    /// Pairs of circle i (as the lower index) are `pair_start[i]..pair_start[i + 1]`.
+    pair_start: Vec<u32>,
+    /// Reaction slots, one per pair.
+    out_j: Vec<JOut>,
+    acc: Vec<Acc>,
+    /// Per circle: the pairs in which it is j, ascending i (indices into `out_j`).
+    j_start: Vec<u32>,
+    j_list: Vec<u32>,
+    /// Every body is a single circle at its centre (circle c = body c): fused fast paths.
+    all_disks: bool,
     wall_buf: Vec<(Vec2, f64)>,
     n_circles: usize,
+    n_bodies: usize,
     checked_dt: f64,
     pub rebuilds: u64,
 }
@@ -131,7 +152,7 @@ impl Stepper {
 
     /// Number of pairs in contact at the last force evaluation.
     pub fn n_contacts(&self) -> usize {
-        self.out.iter().filter(|o| o.touch).count()
+        self.acc.iter().map(|a| a.n as usize).sum()
     }
 
     /// Advance `sys` by one step.
@@ -143,7 +164,8 @@ impl Stepper {
         sys: &mut System,
     ) -> Result<(), DemError> {
         let dt = p.dt;
-        if self.checked_dt != dt || self.n_circles != sys.bodies.n_circles() {
+        let shape = (sys.bodies.n_circles(), sys.bodies.len());
+        if self.checked_dt != dt || (self.n_circles, self.n_bodies) != shape {
             let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
             if dt.is_nan() || dt <= 0.0 || dt > crit {
                 return Err(DemError::TimeStepTooLarge {
@@ -154,9 +176,12 @@ impl Stepper {
                 });
             }
             self.checked_dt = dt;
-            let fresh = self.n_circles != sys.bodies.n_circles() || self.ref_pos.is_empty();
-            self.n_circles = sys.bodies.n_circles();
+            let fresh = (self.n_circles, self.n_bodies) != shape || self.ref_pos.is_empty();
+            (self.n_circles, self.n_bodies) = shape;
             if fresh {
+                let b = &sys.bodies;
+                self.all_disks =
+                    b.n_circles() == b.len() && b.circle_offset.iter().all(|o| o.x == 0.0 && o.y == 0.0);
                 self.update_circles(sys);
                 self.rebuild(sys, p.skin)?;
                 if sys.step == 0 {
@@ -165,13 +190,17 @@ impl Stepper {
                 }
             }
         }
-        self.kick_drift(sys, 0.5 * dt, dt);
         update_wall_velocities(&mut sys.walls, wall_law.max_stiffness(1.0), dt);
         for w in sys.walls.iter_mut() {
             let v = w.vel;
             w.translate(v * dt);
         }
-        let worst = self.update_circles(sys);
+        let worst = if self.all_disks {
+            self.kick_drift_disks(sys, 0.5 * dt, dt)
+        } else {
+            self.kick_drift(sys, 0.5 * dt, dt);
+            self.update_circles(sys)
+        };
         let half_skin2 = 0.25 * p.skin * p.skin;
         if !worst.is_finite() {
             let body = (0..sys.bodies.len())
@@ -186,6 +215,41 @@ impl Stepper {
         sys.time += dt;
         sys.step += 1;
         Ok(())
+    }
+
+    /// [`Stepper::kick_drift`] and [`Stepper::update_circles`] in one pass when every body is a
+    /// single centred circle (circle k = body k).
+    fn kick_drift_disks(&mut self, sys: &mut System, h: f64, dt: f64) -> f64 {
+        let dom = sys.domain;
+        let b = &mut sys.bodies;
+        let (force, mass, torque, inertia, rad) = (&b.force, &b.mass, &b.torque, &b.inertia, &b.circle_r);
+        let nc = b.pos.len();
+        self.cpos.resize(nc, Vec2::ZERO);
+        self.carm.resize(nc, Vec2::ZERO);
+        self.cstate.resize(nc, CircleState::default());
+        let refp = &self.ref_pos;
+        b.pos
+            .par_iter_mut()
+            .zip(b.vel.par_iter_mut())
+            .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
+            .zip(self.cstate.par_iter_mut())
+            .enumerate()
+            .with_min_len(2048)
+            .map(|(k, (((x, v), (a, w)), st))| {
+                *v += force[k] * (h / mass[k]);
+                *w += torque[k] * h / inertia[k];
+                *x = dom.wrap(*x + *v * dt);
+                *a += *w * dt;
+                *st = CircleState {
+                    pos: *x,
+                    vel: *v,
+                    omega: *w,
+                    r: rad[k],
+                    mass: mass[k],
+                };
+                dom.min_image(*x - refp[k]).norm2()
+            })
+            .reduce(|| 0.0, nan_max)
     }
 
     /// Half kick then drift, fused in one pass over the bodies.
@@ -246,20 +310,15 @@ impl Stepper {
                     x.norm2() * 0.0
                 }
             })
-            .reduce(
-                || 0.0,
-                |p, q| {
-                    if p.is_nan() || q.is_nan() {
-                        f64::NAN
-                    } else {
-                        p.max(q)
-                    }
-                },
-            )
+            .reduce(|| 0.0, nan_max)
     }
 
     fn rebuild(&mut self, sys: &mut System, skin: f64) -> Result<(), DemError> {
         let b = &sys.bodies;
+        if self.all_disks {
+            self.cpos.clear();
+            self.cpos.extend(self.cstate.iter().map(|c| c.pos));
+        }
         let pairs = self
             .cells
             .build_pairs(&sys.domain, &self.cpos, &b.circle_r, &b.circle_body, skin)?;
@@ -271,27 +330,31 @@ impl Stepper {
             sys.contacts.wall_hist.resize(need, History::default());
         }
         self.ref_pos.clone_from(&self.cpos);
-        // Per-circle index of pair entries, filled in pair order: canonical partner order.
+        // Pairs of each circle as i (contiguous: the list is sorted), and as j (ascending i).
         let nc = b.n_circles();
-        self.csr_start.clear();
-        self.csr_start.resize(nc + 1, 0);
-        for pr in &sys.contacts.pairs {
-            self.csr_start[pr[0] as usize + 1] += 1;
-            self.csr_start[pr[1] as usize + 1] += 1;
+        let pairs = &sys.contacts.pairs;
+        self.pair_start.clear();
+        self.pair_start.resize(nc + 1, 0);
+        self.j_start.clear();
+        self.j_start.resize(nc + 1, 0);
+        for pr in pairs {
+            self.pair_start[pr[0] as usize + 1] += 1;
+            self.j_start[pr[1] as usize + 1] += 1;
         }
         for c in 0..nc {
-            self.csr_start[c + 1] += self.csr_start[c];
+            self.pair_start[c + 1] += self.pair_start[c];
+            self.j_start[c + 1] += self.j_start[c];
         }
-        self.csr.clear();
-        self.csr.resize(self.csr_start[nc] as usize, 0);
-        let mut fill: Vec<u32> = self.csr_start[..nc].to_vec();
-        for (k, pr) in sys.contacts.pairs.iter().enumerate() {
-            for (side, &c) in pr.iter().enumerate() {
-                self.csr[fill[c as usize] as usize] = ((k as u32) << 1) | side as u32;
-                fill[c as usize] += 1;
-            }
+        self.j_list.clear();
+        self.j_list.resize(pairs.len(), 0);
+        let mut fill: Vec<u32> = self.j_start[..nc].to_vec();
+        for (k, pr) in pairs.iter().enumerate() {
+            let c = pr[1] as usize;
+            self.j_list[fill[c] as usize] = k as u32;
+            fill[c] += 1;
         }
-        self.out.resize(sys.contacts.pairs.len(), PairOut::default());
+        self.out_j.resize(pairs.len(), JOut::default());
+        self.acc.resize(nc, Acc::default());
         self.rebuilds += 1;
         Ok(())
     }
@@ -299,70 +362,83 @@ impl Stepper {
     /// Forces and torques on every body; then, if `h > 0`, the closing half kick v += F/m h.
     fn forces<L: ContactLaw>(&mut self, p: &StepParams, law: &L, wall_law: &L, sys: &mut System, h: f64) {
         let dt = p.dt;
-        let b = &sys.bodies;
         let dom = sys.domain;
-        self.cstate.resize(b.n_circles(), CircleState::default());
-        self.cstate
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(4096)
-            .for_each(|(c, s)| {
-                let k = b.circle_body[c] as usize;
-                *s = CircleState {
-                    pos: self.cpos[c],
-                    vel: b.vel[k] + self.carm[c].spin(b.omega[k]),
-                    omega: b.omega[k],
-                    r: b.circle_r[c],
-                    mass: b.mass[k],
-                };
-            });
-        let (cpos, carm, cst) = (&self.cpos, &self.carm, &self.cstate);
-        // 1. Pair forces, one per pair, in parallel.
-        sys.contacts
-            .pairs
-            .par_iter()
-            .zip(sys.contacts.hist.par_iter_mut())
-            .zip(self.out.par_iter_mut())
-            .with_min_len(1024)
-            .for_each(|((pr, h), o)| {
-                let (ci, cj) = (&cst[pr[0] as usize], &cst[pr[1] as usize]);
-                let d = dom.min_image(cj.pos - ci.pos);
-                let (ri, rj) = (ci.r, cj.r);
-                let rs = ri + rj;
-                let d2 = d.norm2();
-                if d2 >= rs * rs {
-                    *h = History::default();
-                    *o = PairOut::default();
-                    return;
+        let (carm, cst) = (&self.carm, &self.cstate);
+        // 1. Pairs by circle i, in parallel over fixed chunks of circles: the force on i summed
+        //    in ascending j, the reaction on j into the pair's slot.
+        {
+            let ps = &self.pair_start;
+            let nc = cst.len();
+            let pairs = &sys.contacts.pairs;
+            let mut tasks = Vec::with_capacity(nc.div_ceil(PAIR_CHUNK));
+            let (mut hist, mut outj) = (&mut sys.contacts.hist[..], &mut self.out_j[..]);
+            for (k, acc) in self.acc.chunks_mut(PAIR_CHUNK).enumerate() {
+                let (c0, c1) = (k * PAIR_CHUNK, (k * PAIR_CHUNK + acc.len()));
+                let len = (ps[c1] - ps[c0]) as usize;
+                let (h, hr) = hist.split_at_mut(len);
+                let (o, or) = outj.split_at_mut(len);
+                hist = hr;
+                outj = or;
+                tasks.push((c0, acc, h, o));
+            }
+            tasks.into_par_iter().for_each(|(c0, acc, hist, outj)| {
+                let base = ps[c0] as usize;
+                for (di, a) in acc.iter_mut().enumerate() {
+                    let i = c0 + di;
+                    let ci = &cst[i];
+                    let (mut fa, mut ta, mut na) = (Vec2::ZERO, 0.0, 0u32);
+                    let (q0, q1) = (ps[i] as usize, ps[i + 1] as usize);
+                    for ((pr, h), o) in pairs[q0..q1]
+                        .iter()
+                        .zip(hist[q0 - base..q1 - base].iter_mut())
+                        .zip(outj[q0 - base..q1 - base].iter_mut())
+                    {
+                        let cj = &cst[pr[1] as usize];
+                        let d = dom.min_image(cj.pos - ci.pos);
+                        let (ri, rj) = (ci.r, cj.r);
+                        let rs = ri + rj;
+                        let d2 = d.norm2();
+                        if d2 >= rs * rs {
+                            if *h != History::default() {
+                                *h = History::default();
+                            }
+                            *o = JOut::default();
+                            continue;
+                        }
+                        let dist = d2.sqrt();
+                        let n = d * (1.0 / dist);
+                        let delta = rs - dist;
+                        let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
+                        let (wi, wj) = (ci.omega, cj.omega);
+                        let vi = ci.vel + (n * ai).spin(wi);
+                        let vj = cj.vel - (n * aj).spin(wj);
+                        let (mi, mj) = (ci.mass, cj.mass);
+                        let c = ContactInput {
+                            delta,
+                            n,
+                            v_rel: vi - vj,
+                            w_rel: wi - wj,
+                            r_eff: ri * rj / rs,
+                            m_eff: mi * mj / (mi + mj),
+                            dt,
+                        };
+                        let r = law.force(&c, h);
+                        let nxf = n.cross(r.f);
+                        fa += r.f;
+                        ta += ai * nxf + r.m_roll;
+                        na += 1;
+                        *o = JOut {
+                            f: -r.f,
+                            t: aj * nxf - r.m_roll,
+                        };
+                    }
+                    *a = Acc { f: fa, t: ta, n: na };
                 }
-                let dist = d2.sqrt();
-                let n = d * (1.0 / dist);
-                let delta = rs - dist;
-                let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
-                let (wi, wj) = (ci.omega, cj.omega);
-                let vi = ci.vel + (n * ai).spin(wi);
-                let vj = cj.vel - (n * aj).spin(wj);
-                let (mi, mj) = (ci.mass, cj.mass);
-                let c = ContactInput {
-                    delta,
-                    n,
-                    v_rel: vi - vj,
-                    w_rel: wi - wj,
-                    r_eff: ri * rj / rs,
-                    m_eff: mi * mj / (mi + mj),
-                    dt,
-                };
-                let r = law.force(&c, h);
-                let nxf = n.cross(r.f);
-                *o = PairOut {
-                    f: r.f,
-                    ti: ai * nxf + r.m_roll,
-                    tj: aj * nxf - r.m_roll,
-                    touch: true,
-                };
             });
-        // 2. Gather per body in canonical order. Without walls, bonds or membrane nothing else
-        //    adds to the contact forces, so body forces, damping and the kick follow in the same pass.
+        }
+        // 2. Per body: each circle's own sum plus its reactions in ascending i. Without walls,
+        //    bonds or membrane nothing else adds to the contact forces, so body forces, damping
+        //    and the kick follow in the same pass.
         let g = p.gravity * p.gravity_factor;
         let fin = Finish {
             g,
@@ -371,7 +447,17 @@ impl Stepper {
             h,
         };
         let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
-        let (out, csr, cs) = (&self.out, &self.csr, &self.csr_start);
+        let (outj, acc, js, jl) = (&self.out_j, &self.acc, &self.j_start, &self.j_list);
+        let circle_sum = |c: usize| -> (Vec2, f64) {
+            let (mut fc, mut tc) = (acc[c].f, acc[c].t);
+            for &q in &jl[js[c] as usize..js[c + 1] as usize] {
+                let o = &outj[q as usize];
+                fc += o.f;
+                tc += o.t;
+            }
+            (fc, tc)
+        };
+        let disks = self.all_disks;
         let bodies = &mut sys.bodies;
         let Bodies5 {
             force,
@@ -389,26 +475,21 @@ impl Stepper {
             .zip(torque.par_iter_mut())
             .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
             .enumerate()
-            .with_min_len(512)
+            .with_min_len(1024)
             .for_each(|(k, ((f, t), (v, w)))| {
-                let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
-                for c in cstart[k]..cstart[k + 1] {
-                    let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
-                    for &e in &csr[cs[c] as usize..cs[c + 1] as usize] {
-                        let o = &out[(e >> 1) as usize];
-                        if e & 1 == 0 {
-                            fc += o.f;
-                            tc += o.ti;
-                        } else {
-                            fc -= o.f;
-                            tc += o.tj;
-                        }
+                if disks {
+                    (*f, *t) = circle_sum(k);
+                } else {
+                    let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
+                    let c0 = cstart[k];
+                    for (c, arm) in (c0..).zip(&carm[c0..cstart[k + 1]]) {
+                        let (fc, tc) = circle_sum(c);
+                        fb += fc;
+                        tb += tc + arm.cross(fc);
                     }
-                    fb += fc;
-                    tb += tc + carm[c].cross(fc);
+                    *f = fb;
+                    *t = tb;
                 }
-                *f = fb;
-                *t = tb;
                 if simple {
                     fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
                 }
@@ -431,7 +512,7 @@ impl Stepper {
                     let k = b.circle_body[c] as usize;
                     let r = b.circle_r[c];
                     for w in 0..nw {
-                        match walls[w].touch(cpos[c], r) {
+                        match walls[w].touch(cst[c].pos, r) {
                             None => {
                                 hist[w] = History::default();
                                 buf[w] = (Vec2::ZERO, 0.0);
@@ -478,7 +559,7 @@ impl Stepper {
             let bodies = &mut sys.bodies;
             for bond in sys.bonds.iter_mut().filter(|b| !b.broken) {
                 let (i, j) = (bond.i as usize, bond.j as usize);
-                let d = dom.min_image(cpos[j] - cpos[i]);
+                let d = dom.min_image(cst[j].pos - cst[i].pos);
                 let dist = d.norm();
                 let n = d * (1.0 / dist);
                 let (ri, rj) = (bodies.circle_r[i], bodies.circle_r[j]);
@@ -546,7 +627,7 @@ struct Finish {
 }
 
 impl Finish {
-    #[inline]
+    #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn apply(&self, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64, m: f64, i: f64, ef: Vec2, et: f64) {
         *f += self.g * m + ef;
@@ -564,6 +645,16 @@ impl Finish {
             *v += *f * (self.h / m);
             *w += *t * self.h / i;
         }
+    }
+}
+
+/// Maximum that propagates NaN (a non-finite position must stop the run).
+#[inline]
+fn nan_max(p: f64, q: f64) -> f64 {
+    if p.is_nan() || q.is_nan() {
+        f64::NAN
+    } else {
+        p.max(q)
     }
 }
 
