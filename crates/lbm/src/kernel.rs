@@ -41,6 +41,34 @@ impl Default for Limits {
     }
 }
 
+impl Limits {
+    /// The limits in the storage precision: the per-node check is then three vector compares on
+    /// ρ and |u|² as the collision computed them (a NaN fails every compare, so it is caught).
+    pub fn in_precision<T: Real>(&self) -> LimitsT<T> {
+        LimitsT {
+            rho_min: T::from_f64(self.rho_min),
+            rho_max: T::from_f64(self.rho_max),
+            usq_max: T::from_f64(self.u_max * self.u_max),
+        }
+    }
+}
+
+/// `Limits` rounded to the storage precision (see `Limits::in_precision`).
+#[derive(Clone, Copy, Debug)]
+pub struct LimitsT<T> {
+    pub rho_min: T,
+    pub rho_max: T,
+    pub usq_max: T,
+}
+
+impl<T: Real> LimitsT<T> {
+    /// True when the node is within the limits (false for NaN).
+    #[inline(always)]
+    pub fn within(&self, rho: T, usq: T) -> bool {
+        (rho > self.rho_min) & (rho < self.rho_max) & (usq < self.usq_max)
+    }
+}
+
 /// Where the kernel writes ρ and u (f64, node order; u interleaved xyz) when asked.
 #[derive(Clone, Copy)]
 pub struct MacroOut {
@@ -57,15 +85,8 @@ pub struct Ctx<'a, T> {
     pub params: CollideParams<T>,
     /// Motion of each obstacle, then of the six faces (velocity only).
     pub motions: &'a [Motion],
-    pub limits: Limits,
+    pub limits: LimitsT<T>,
     pub out: Option<MacroOut>,
-}
-
-#[inline(always)]
-fn ok<T: Real>(rho: T, u: [T; 3], l: &Limits) -> bool {
-    let usq = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).to_f64();
-    let r = rho.to_f64();
-    r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max
 }
 
 /// Update row `r` (y + ny z). Returns false if a node left the limits (or is not finite).
@@ -134,7 +155,7 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
 fn finish_block<T: Real, const B: usize>(ctx: &Ctx<T>, m: &Moments<T, B>, idx0: usize, count: usize) -> bool {
     let mut good = true;
     for w in 0..count {
-        good &= ok(m.rho[w], [m.u[0][w], m.u[1][w], m.u[2][w]], &ctx.limits);
+        good &= ctx.limits.within(m.rho[w], m.usq[w]);
     }
     if let Some(o) = ctx.out {
         for w in 0..count {

@@ -14,8 +14,9 @@
 
 use crate::collision::{CollideParams, Moments, collide_block};
 use crate::domain::{Domain, FLUID, Motion};
-use crate::kernel::{Limits, MacroOut, SyncPtr, W};
+use crate::kernel::{LimitsT, MacroOut, SyncPtr, W};
 use crate::lattice::{Lattice, QMAX};
+use crate::layout::Layout;
 use crate::plan::{Plan, Upstream, neighbour};
 use crate::real::Real;
 
@@ -25,11 +26,12 @@ pub type Bad = Option<(usize, f64, [f64; 3])>;
 pub struct CtxAa<'a, T> {
     pub dom: &'a Domain,
     pub plan: &'a Plan,
-    /// The single population array (read and written through raw pointers only).
+    /// The single population array (read and written through raw pointers only), in `layout`.
     pub f: SyncPtr<T>,
+    pub layout: Layout,
     pub params: CollideParams<T>,
     pub motions: &'a [Motion],
-    pub limits: Limits,
+    pub limits: LimitsT<T>,
     pub out: Option<MacroOut>,
 }
 
@@ -42,19 +44,15 @@ fn check<T: Real, const B: usize>(
     bad: &mut Bad,
 ) {
     let l = &ctx.limits;
-    let mut any = false;
+    let mut all = true;
     for w in 0..count {
-        let usq = (m.u[0][w] * m.u[0][w] + m.u[1][w] * m.u[1][w] + m.u[2][w] * m.u[2][w]).to_f64();
-        let r = m.rho[w].to_f64();
-        any |= !(r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max);
+        all &= l.within(m.rho[w], m.usq[w]);
     }
-    if any && bad.is_none() {
+    if !all && bad.is_none() {
         for w in 0..count {
-            let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
-            let r = m.rho[w].to_f64();
-            let usq = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-            if !(r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max) {
-                *bad = Some(((idx0 + w) % ctx.dom.n[0], r, u));
+            if !l.within(m.rho[w], m.usq[w]) {
+                let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
+                *bad = Some(((idx0 + w) % ctx.dom.n[0], m.rho[w].to_f64(), u));
                 break;
             }
         }
@@ -76,12 +74,14 @@ fn check<T: Real, const B: usize>(
 /// Even step of row `r`: local collide, slot i -> slot opp(i), over every fluid run of the row.
 ///
 /// # Safety
-/// `ctx.f` must hold Q n values; no other thread may touch the nodes of row `r`.
+/// `ctx.f` must hold Q `ctx.layout.stride` values; no other thread may touch the nodes of row `r`.
 pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
     let dom = ctx.dom;
     let nx = dom.n[0];
-    let n = dom.len();
+    let n = ctx.layout.stride;
+    // node index of x = 0 (macroscopic output, diagnosis) and its slot in the padded array
     let row_off = r * nx;
+    let slot_off = r * ctx.layout.nxp;
     let mut bad = None;
     let kind = &dom.kind[row_off..row_off + nx];
     let mut x = 0;
@@ -101,13 +101,13 @@ pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: us
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
                 // SAFETY: in bounds, own nodes.
                 unsafe {
-                    std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + row_off + xb), fi.as_mut_ptr(), W)
+                    std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + slot_off + xb), fi.as_mut_ptr(), W)
                 };
             }
             let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
                 let o = L::OPP[i];
-                unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(o * n + row_off + xb), W) };
+                unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(o * n + slot_off + xb), W) };
             }
             check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
             xb += W;
@@ -115,11 +115,11 @@ pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: us
         while xb < x {
             let mut f = [[T::default(); 1]; QMAX];
             for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                fi[0] = unsafe { *ctx.f.0.add(i * n + row_off + xb) };
+                fi[0] = unsafe { *ctx.f.0.add(i * n + slot_off + xb) };
             }
             let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
             for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe { *ctx.f.0.add(L::OPP[i] * n + row_off + xb) = fi[0] };
+                unsafe { *ctx.f.0.add(L::OPP[i] * n + slot_off + xb) = fi[0] };
             }
             check::<T, 1>(ctx, &m, row_off + xb, 1, &mut bad);
             xb += 1;
@@ -136,7 +136,8 @@ pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: us
 pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
     let dom = ctx.dom;
     let [nx, ny, nz] = dom.n;
-    let n = dom.len();
+    let n = ctx.layout.stride;
+    let nxp = ctx.layout.nxp;
     let (y, z) = (r % ny, r / ny);
     let row_off = r * nx;
     let mut bad = None;
@@ -147,7 +148,7 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
         let row_of = |s: i64| {
             let ys = (y as i64 + s * c[1] as i64).rem_euclid(ny as i64) as usize;
             let zs = (z as i64 + s * c[2] as i64).rem_euclid(nz as i64) as usize;
-            (ys + ny * zs) * nx
+            (ys + ny * zs) * nxp
         };
         // read slot opp(i) of y - c_i; write slot i of y + c_i
         up[i] = (L::OPP[i] * n + row_of(-1)).wrapping_sub(c[0] as isize as usize);
@@ -208,7 +209,7 @@ fn wall_velocity(ctx: &CtxAa<impl Real>, p: [usize; 3], c: [i32; 3], sign: f64, 
 
 unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [usize; 3], bad: &mut Bad) {
     let dom = ctx.dom;
-    let n = dom.len();
+    let lay = &ctx.layout;
     let idx = dom.index(p[0], p[1], p[2]);
     let n_obst = ctx.motions.len() - 6;
     let dotw = |i: usize, u: [f64; 3]| {
@@ -221,13 +222,13 @@ unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [us
         let c = L::C[i];
         // SAFETY (all raw accesses): indices in bounds; slots owned by this node.
         fi[0] = match neighbour(dom, p, [-c[0], -c[1], -c[2]]) {
-            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(L::OPP[i] * n + s) },
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(lay.slot(L::OPP[i], s)) },
             Upstream::Node(s) => {
                 let uw = wall_velocity(ctx, p, c, -1.0, s);
-                unsafe { *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, uw)) }
+                unsafe { *ctx.f.0.add(lay.slot(i, idx)) + T::from_f64(dotw(i, uw)) }
             }
             Upstream::Face(fc) => unsafe {
-                *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, face_velocity(fc)))
+                *ctx.f.0.add(lay.slot(i, idx)) + T::from_f64(dotw(i, face_velocity(fc)))
             },
         };
     }
@@ -236,13 +237,13 @@ unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [us
         let c = L::C[i];
         let o = L::OPP[i];
         match neighbour(dom, p, c) {
-            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(i * n + s) = fi[0] },
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(lay.slot(i, s)) = fi[0] },
             Upstream::Node(s) => {
                 let uw = wall_velocity(ctx, p, c, 1.0, s);
-                unsafe { *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, uw)) }
+                unsafe { *ctx.f.0.add(lay.slot(o, idx)) = fi[0] + T::from_f64(dotw(o, uw)) }
             }
             Upstream::Face(fc) => unsafe {
-                *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, face_velocity(fc)))
+                *ctx.f.0.add(lay.slot(o, idx)) = fi[0] + T::from_f64(dotw(o, face_velocity(fc)))
             },
         }
     }

@@ -21,6 +21,10 @@ pub trait Real:
     const NAME: &'static str;
     fn from_f64(x: f64) -> Self;
     fn to_f64(self) -> f64;
+    /// Fused `self * a + b`, one rounding (one FMA instruction with `target-cpu=native`). Used
+    /// explicitly where the kernels want it, so every code path (blocks of nodes, single nodes,
+    /// both kernels) rounds the same way: results stay bitwise reproducible.
+    fn mul_add(self, a: Self, b: Self) -> Self;
 }
 
 impl Real for f64 {
@@ -33,6 +37,10 @@ impl Real for f64 {
     fn to_f64(self) -> f64 {
         self
     }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        f64::mul_add(self, a, b)
+    }
 }
 
 impl Real for f32 {
@@ -44,5 +52,9 @@ impl Real for f32 {
     #[inline(always)]
     fn to_f64(self) -> f64 {
         self as f64
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        f32::mul_add(self, a, b)
     }
 }
