@@ -14,7 +14,7 @@
 
 use crate::collision::{CollideParams, Moments, collide_block};
 use crate::domain::{Domain, FLUID, Motion};
-use crate::kernel::{LimitsT, MacroOut, SyncPtr, W};
+use crate::kernel::{LimitsT, MacroOut, SyncPtr, wide};
 use crate::lattice::{Lattice, QMAX};
 use crate::layout::Layout;
 use crate::plan::{Plan, Upstream, neighbour};
@@ -35,30 +35,15 @@ pub struct CtxAa<'a, T> {
     pub out: Option<MacroOut>,
 }
 
+/// Range check of a block of `B` nodes starting at node `idx0` (and the macroscopic output).
 #[inline(always)]
-fn check<T: Real, const B: usize>(
-    ctx: &CtxAa<T>,
-    m: &Moments<T, B>,
-    idx0: usize,
-    count: usize,
-    bad: &mut Bad,
-) {
-    let l = &ctx.limits;
-    let mut all = true;
-    for w in 0..count {
-        all &= l.within(m.rho[w], m.usq[w]);
-    }
-    if !all && bad.is_none() {
-        for w in 0..count {
-            if !l.within(m.rho[w], m.usq[w]) {
-                let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
-                *bad = Some(((idx0 + w) % ctx.dom.n[0], m.rho[w].to_f64(), u));
-                break;
-            }
-        }
+fn check<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize, bad: &mut Bad) {
+    let bits = ctx.limits.bad_lanes(&m.rho, &m.usq);
+    if bits != 0 && bad.is_none() {
+        *bad = first_bad(ctx, m, idx0, bits);
     }
     if let Some(o) = ctx.out {
-        for w in 0..count {
+        for w in 0..B {
             let idx = idx0 + w;
             // SAFETY: node idx belongs to the calling row.
             unsafe {
@@ -69,6 +54,15 @@ fn check<T: Real, const B: usize>(
             }
         }
     }
+}
+
+/// The first node of a block flagged in `bits`, for the diagnosis (rare: kept out of line).
+#[cold]
+#[inline(never)]
+fn first_bad<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize, bits: u32) -> Bad {
+    let w = bits.trailing_zeros() as usize;
+    let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
+    Some(((idx0 + w) % ctx.dom.n[0], m.rho[w].to_f64(), u))
 }
 
 /// Even step of row `r`: local collide, slot i -> slot opp(i), over every fluid run of the row.
@@ -83,49 +77,99 @@ pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: us
     let row_off = r * nx;
     let slot_off = r * ctx.layout.nxp;
     let mut bad = None;
-    let kind = &dom.kind[row_off..row_off + nx];
-    let mut x = 0;
-    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
-    let mut f = [[T::default(); W]; QMAX];
-    while x < nx {
-        if kind[x] != FLUID {
-            x += 1;
-            continue;
-        }
-        let x0 = x;
-        while x < nx && kind[x] == FLUID {
-            x += 1;
-        }
-        let mut xb = x0;
-        while xb + W <= x {
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                // SAFETY: in bounds, own nodes.
-                unsafe {
-                    std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + slot_off + xb), fi.as_mut_ptr(), W)
-                };
-            }
-            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                let o = L::OPP[i];
-                unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(o * n + slot_off + xb), W) };
-            }
-            check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
-            xb += W;
-        }
-        while xb < x {
-            let mut f = [[T::default(); 1]; QMAX];
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                fi[0] = unsafe { *ctx.f.0.add(i * n + slot_off + xb) };
-            }
-            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe { *ctx.f.0.add(L::OPP[i] * n + slot_off + xb) = fi[0] };
-            }
-            check::<T, 1>(ctx, &m, row_off + xb, 1, &mut bad);
-            xb += 1;
-        }
+    let plan = ctx.plan;
+    // slot i -> slot opp(i) of the same node
+    let mut src = [0usize; QMAX];
+    let mut dst = [0usize; QMAX];
+    for i in 0..L::Q {
+        src[i] = i * n + slot_off;
+        dst[i] = L::OPP[i] * n + slot_off;
+    }
+    for &(x0, x1) in &plan.runs[plan.run_start[r] as usize..plan.run_start[r + 1] as usize] {
+        unsafe { run::<L, T, F>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     bad
+}
+
+/// Gather `B` consecutive nodes from slots `src[i] + x`, collide, scatter to `dst[i] + x`, check.
+///
+/// # Safety
+/// The slots must be in bounds and belong to nodes of the calling row (module doc).
+#[inline(always)]
+unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
+    ctx: &CtxAa<T>,
+    f: &mut [[T; B]; QMAX],
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x: usize,
+    node: usize,
+    bad: &mut Bad,
+) {
+    for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+        unsafe { std::ptr::copy_nonoverlapping(ctx.f.0.add(src[i].wrapping_add(x)), fi.as_mut_ptr(), B) };
+    }
+    let m = collide_block::<L, T, B, F>(f, &ctx.params);
+    for (i, fi) in f.iter().enumerate().take(L::Q) {
+        unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(dst[i].wrapping_add(x)), B) };
+    }
+    check::<T, B>(ctx, &m, node, bad);
+}
+
+/// Nodes [x0, x1) of a row in blocks of `kernel::wide::<T>()` nodes (two AVX-512 registers per
+/// quantity), the rest in one block each of 16, 8, 4, 2 and 1 nodes at most (narrower vectors
+/// instead of up to 31 scalar nodes).
+///
+/// # Safety
+/// As `block`.
+#[inline(always)]
+unsafe fn run<L: Lattice, T: Real, const F: bool>(
+    ctx: &CtxAa<T>,
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x0: usize,
+    x1: usize,
+    node_off: usize,
+    bad: &mut Bad,
+) {
+    if wide::<T>() == 32 {
+        unsafe { run_w::<L, T, F, 32>(ctx, src, dst, x0, x1, node_off, bad) }
+    } else {
+        unsafe { run_w::<L, T, F, 16>(ctx, src, dst, x0, x1, node_off, bad) }
+    }
+}
+
+#[inline(always)]
+unsafe fn run_w<L: Lattice, T: Real, const F: bool, const WB: usize>(
+    ctx: &CtxAa<T>,
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x0: usize,
+    x1: usize,
+    node_off: usize,
+    bad: &mut Bad,
+) {
+    // block scratch, reused (zeroing it per block would cost more than the loads)
+    let mut f = [[T::default(); WB]; QMAX];
+    let mut x = x0;
+    while x + WB <= x1 {
+        unsafe { block::<L, T, WB, F>(ctx, &mut f, src, dst, x, node_off + x, bad) };
+        x += WB;
+    }
+    macro_rules! tail {
+        ($b:literal) => {
+            if $b < WB && $b <= x1 - x {
+                let mut g = [[T::default(); $b]; QMAX];
+                unsafe { block::<L, T, $b, F>(ctx, &mut g, src, dst, x, node_off + x, bad) };
+                x += $b;
+            }
+        };
+    }
+    tail!(16);
+    tail!(8);
+    tail!(4);
+    tail!(2);
+    tail!(1);
+    debug_assert_eq!(x, x1);
 }
 
 /// Odd step of row `r`: gather from neighbours, collide, scatter to neighbours.
@@ -143,6 +187,9 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
     let mut bad = None;
     let mut up = [0usize; QMAX];
     let mut down = [0usize; QMAX];
+    // the same without the x offset (periodic-edge nodes add their wrapped x)
+    let mut up_row = [0usize; QMAX];
+    let mut down_row = [0usize; QMAX];
     for i in 0..L::Q {
         let c = L::C[i];
         let row_of = |s: i64| {
@@ -151,47 +198,44 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
             (ys + ny * zs) * nxp
         };
         // read slot opp(i) of y - c_i; write slot i of y + c_i
-        up[i] = (L::OPP[i] * n + row_of(-1)).wrapping_sub(c[0] as isize as usize);
-        down[i] = (i * n + row_of(1)).wrapping_add(c[0] as isize as usize);
+        up_row[i] = L::OPP[i] * n + row_of(-1);
+        down_row[i] = i * n + row_of(1);
+        up[i] = up_row[i].wrapping_sub(c[0] as isize as usize);
+        down[i] = down_row[i].wrapping_add(c[0] as isize as usize);
     }
     let plan = ctx.plan;
-    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
-    let mut f = [[T::default(); W]; QMAX];
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
-        let (x0, x1) = (x0 as usize, x1 as usize);
-        let mut xb = x0;
-        while xb + W <= x1 {
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                unsafe {
-                    std::ptr::copy_nonoverlapping(ctx.f.0.add(up[i].wrapping_add(xb)), fi.as_mut_ptr(), W)
-                };
-            }
-            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe {
-                    std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(down[i].wrapping_add(xb)), W)
-                };
-            }
-            check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
-            xb += W;
+        unsafe { run::<L, T, F>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
+    }
+    for &x in &plan.wraps[plan.wrap_start[r] as usize..plan.wrap_start[r + 1] as usize] {
+        let x = x as usize;
+        let mut f = [[T::default(); 1]; QMAX];
+        for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+            fi[0] = unsafe { *ctx.f.0.add(up_row[i] + wrap_x(x, -L::C[i][0], nx)) };
         }
-        while xb < x1 {
-            let mut f = [[T::default(); 1]; QMAX];
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                fi[0] = unsafe { *ctx.f.0.add(up[i].wrapping_add(xb)) };
-            }
-            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe { *ctx.f.0.add(down[i].wrapping_add(xb)) = fi[0] };
-            }
-            check::<T, 1>(ctx, &m, row_off + xb, 1, &mut bad);
-            xb += 1;
+        let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+        for (i, fi) in f.iter().enumerate().take(L::Q) {
+            unsafe { *ctx.f.0.add(down_row[i] + wrap_x(x, L::C[i][0], nx)) = fi[0] };
         }
+        check::<T, 1>(ctx, &m, row_off + x, &mut bad);
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
         unsafe { odd_general::<L, T, F>(ctx, [x as usize, y, z], &mut bad) };
     }
     bad
+}
+
+/// x + d on a periodic row of `nx` nodes, d in {-1, 0, 1}.
+#[inline(always)]
+pub fn wrap_x(x: usize, d: i32, nx: usize) -> usize {
+    let s = x as isize + d as isize;
+    if s < 0 {
+        (s + nx as isize) as usize
+    } else if s >= nx as isize {
+        (s - nx as isize) as usize
+    } else {
+        s as usize
+    }
 }
 
 /// Wall velocity at the link midpoint p + s c/2 towards a solid node `s_idx` (obstacle or inactive).
@@ -247,5 +291,5 @@ unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [us
             },
         }
     }
-    check::<T, 1>(ctx, &m, idx, 1, bad);
+    check::<T, 1>(ctx, &m, idx, bad);
 }
