@@ -28,13 +28,21 @@ fn run<T: Real>(nx: usize, ny: usize, reps: usize, collision: Collision, two: bo
         limits: Limits::default(),
     };
     let steps = ((work / n).max(2)) & !1;
-    let mut c: Vec<Vec<T>> = (0..9).map(|i| vec![T::from_f64(1.0 + i as f64); n]).collect();
+    // 64-byte aligned, as the kernel's array and `lbdem bench lbm`'s ceilings
+    let mut c: Vec<(Vec<T>, usize)> = (0..9)
+        .map(|i| {
+            let v = vec![T::from_f64(1.0 + i as f64); n + 16];
+            let off = v.as_ptr().align_offset(64);
+            (v, off)
+        })
+        .collect();
     let s = T::from_f64(0.999);
     let mut ceiling = || {
         let t = Instant::now();
         for _ in 0..steps {
-            for arr in c.iter_mut() {
-                arr.par_chunks_mut(1 << 14)
+            for (arr, o) in c.iter_mut() {
+                arr[*o..*o + n]
+                    .par_chunks_mut(1 << 14)
                     .for_each(|x| x.iter_mut().for_each(|v| *v = *v * s));
             }
         }

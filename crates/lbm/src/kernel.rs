@@ -27,6 +27,20 @@ pub struct SyncPtr<T>(pub *mut T);
 unsafe impl<T> Send for SyncPtr<T> {}
 unsafe impl<T> Sync for SyncPtr<T> {}
 
+/// v + d on a periodic axis of n nodes, d in {-1, 0, 1} (compares, not a division: this runs
+/// 2Q times per row).
+#[inline(always)]
+pub fn wrap(v: usize, d: i32, n: usize) -> usize {
+    let s = v as isize + d as isize;
+    if s < 0 {
+        (s + n as isize) as usize
+    } else if s >= n as isize {
+        (s - n as isize) as usize
+    } else {
+        s as usize
+    }
+}
+
 /// Accepted range of the macroscopic fields; outside it the run is stopped (see `Stepper`).
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
@@ -117,8 +131,8 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
     let mut up_off = [0usize; QMAX];
     for (i, off) in up_off.iter_mut().enumerate().take(L::Q) {
         let c = L::C[i];
-        let ys = (y as i64 - c[1] as i64).rem_euclid(ny as i64) as usize;
-        let zs = (z as i64 - c[2] as i64).rem_euclid(dom.n[2] as i64) as usize;
+        let ys = wrap(y, -c[1], ny);
+        let zs = wrap(z, -c[2], dom.n[2]);
         *off = i * n + (ys + ny * zs) * nx;
     }
     let plan = ctx.plan;
@@ -143,7 +157,7 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
         let x = x as usize;
         let mut f = [[T::default(); 1]; QMAX];
         for i in 0..L::Q {
-            f[i][0] = ctx.src[up_off[i] + crate::kernel_aa::wrap_x(x, -L::C[i][0], nx)];
+            f[i][0] = ctx.src[up_off[i] + wrap(x, -L::C[i][0], nx)];
         }
         let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
         for i in 0..L::Q {

@@ -14,7 +14,7 @@
 
 use crate::collision::{CollideParams, Moments, collide_block};
 use crate::domain::{Domain, FLUID, Motion};
-use crate::kernel::{LimitsT, MacroOut, SyncPtr, wide};
+use crate::kernel::{LimitsT, MacroOut, SyncPtr, wide, wrap};
 use crate::lattice::{Lattice, QMAX};
 use crate::layout::Layout;
 use crate::plan::{Plan, Upstream, neighbour};
@@ -192,11 +192,7 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
     let mut down_row = [0usize; QMAX];
     for i in 0..L::Q {
         let c = L::C[i];
-        let row_of = |s: i64| {
-            let ys = (y as i64 + s * c[1] as i64).rem_euclid(ny as i64) as usize;
-            let zs = (z as i64 + s * c[2] as i64).rem_euclid(nz as i64) as usize;
-            (ys + ny * zs) * nxp
-        };
+        let row_of = |s: i32| (wrap(y, s * c[1], ny) + ny * wrap(z, s * c[2], nz)) * nxp;
         // read slot opp(i) of y - c_i; write slot i of y + c_i
         up_row[i] = L::OPP[i] * n + row_of(-1);
         down_row[i] = i * n + row_of(1);
@@ -211,11 +207,11 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
         let x = x as usize;
         let mut f = [[T::default(); 1]; QMAX];
         for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-            fi[0] = unsafe { *ctx.f.0.add(up_row[i] + wrap_x(x, -L::C[i][0], nx)) };
+            fi[0] = unsafe { *ctx.f.0.add(up_row[i] + wrap(x, -L::C[i][0], nx)) };
         }
         let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
         for (i, fi) in f.iter().enumerate().take(L::Q) {
-            unsafe { *ctx.f.0.add(down_row[i] + wrap_x(x, L::C[i][0], nx)) = fi[0] };
+            unsafe { *ctx.f.0.add(down_row[i] + wrap(x, L::C[i][0], nx)) = fi[0] };
         }
         check::<T, 1>(ctx, &m, row_off + x, &mut bad);
     }
@@ -223,19 +219,6 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
         unsafe { odd_general::<L, T, F>(ctx, [x as usize, y, z], &mut bad) };
     }
     bad
-}
-
-/// x + d on a periodic row of `nx` nodes, d in {-1, 0, 1}.
-#[inline(always)]
-pub fn wrap_x(x: usize, d: i32, nx: usize) -> usize {
-    let s = x as isize + d as isize;
-    if s < 0 {
-        (s + nx as isize) as usize
-    } else if s >= nx as isize {
-        (s - nx as isize) as usize
-    } else {
-        s as usize
-    }
 }
 
 /// Wall velocity at the link midpoint p + s c/2 towards a solid node `s_idx` (obstacle or inactive).

@@ -56,7 +56,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         }
         let n = fluid.nodes();
         swap_pairs::<L, T>(&mut fluid.f, n);
-        let layout = Layout::padded::<T>(fluid.domain.n);
+        let mut layout = Layout::padded::<T>(fluid.domain.n);
         fluid.f = layout.pack(&fluid.f, L::Q);
         let dom = &fluid.domain;
         let mut motions = fluid.obstacles.clone();
@@ -116,7 +116,8 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         let ctx = CtxAa {
             dom: &fluid.domain,
             plan: &self.plan,
-            f: SyncPtr(fluid.f.as_mut_ptr()),
+            // slot 0 of the layout (the kernel's offsets do not include `base`)
+            f: SyncPtr(fluid.f[self.layout.base..].as_mut_ptr()),
             layout: self.layout,
             params: self.params,
             motions: &self.motions,
@@ -182,7 +183,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
                 (self.motions[t].velocity, [0.0; 3])
             };
             let cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1] + c[2] as f64 * uw[2];
-            let stored = fluid.f[self.layout.slot(o, l.node as usize)].to_f64();
+            let stored = fluid.f[self.layout.base + self.layout.slot(o, l.node as usize)].to_f64();
             let post = if self.reversed {
                 stored
             } else {
