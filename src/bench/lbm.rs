@@ -183,17 +183,25 @@ fn lbmpy(nx: usize, ny: usize, precision: &str, threads: usize) -> Option<f64> {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
-    let sizes: &[(usize, usize)] = if a.quick {
-        &[(256, 192)]
+    let mut sizes: Vec<(usize, usize)> = if a.quick {
+        vec![(256, 192)]
     } else {
-        &[(256, 192), (1024, 1024), (4096, 4096)]
+        vec![(256, 192), (1024, 1024), (4096, 4096)]
     };
+    // LBDEM_BENCH_LBM_SIZE=1024x1024 runs one size only (to repeat a case on a busy machine)
+    if let Ok(v) = std::env::var("LBDEM_BENCH_LBM_SIZE") {
+        let (x, y) = v
+            .split_once('x')
+            .and_then(|(x, y)| Some((x.parse().ok()?, y.parse().ok()?)))
+            .with_context(|| format!("LBDEM_BENCH_LBM_SIZE = {v:?}: expected NXxNY, e.g. 1024x1024"))?;
+        sizes = vec![(x, y)];
+    }
     println!(
         "lbm: D2Q9 BGK (lbmpy: SRT), relaxation rate 1.8, periodic; AA in-place kernels on both sides; \
          ceilings = 9-array updates of the same size measured in this run"
     );
     let mut rows = Vec::new();
-    for &(nx, ny) in sizes {
+    for &(nx, ny) in &sizes {
         for precision in ["f64", "f32"] {
             for threads in [1, 2] {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
