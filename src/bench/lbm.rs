@@ -3,8 +3,15 @@
 //! each next to two memory-traffic ceilings measured in the same run on the same array sizes:
 //! a 9-array two-array copy (read 9 values, write 9 others per node: the traffic of lbdem's
 //! two-array pull kernel, write-allocate included) and a 9-array in-place update (read and write
-//! the same 9 values: the traffic of an AA-pattern kernel such as lbmpy's fastest). With `--peer`
+//! the same 9 values: the traffic of an AA-pattern kernel such as lbmpy's fastest). Every timed
+//! repetition of a kernel is followed by one of its ceiling and the printed ratio is the median of
+//! the per-repetition ratios (the machine is shared: load changes hit both sides alike). With `--peer`
 //! it also runs lbmpy (scripts/peer-lbmpy.sh, AA + AVX-512 variant) and prints lbdem / lbmpy.
+//!
+//! Like with like: both codes run D2Q9 BGK (lbmpy's SRT) with relaxation rate 1.8 on a periodic
+//! box with the AA in-place pattern, in the same precision and on the same number of threads;
+//! lbdem's kernel in addition checks the range of ρ and u of every node every step (its failure
+//! diagnosis) and keeps the plan for walls and obstacles, which lbmpy's generated kernel has not.
 
 use super::{BenchArgs, median};
 use anyhow::{Context, Result};
@@ -28,6 +35,8 @@ struct Row {
     ceiling_two_array: f64,
     /// In-place 9-array update ceiling.
     ceiling_in_place: f64,
+    /// The memory bandwidth that ceiling stands for: 2 x 9 values per node update (GB/s).
+    ceiling_in_place_gbs: f64,
     /// AA MLUPS / in-place ceiling: the figure of merit.
     ratio_in_place: f64,
     /// Two-array MLUPS / two-array ceiling.
@@ -44,8 +53,25 @@ fn steps_for(n: usize) -> usize {
     (WORK / n).max(2)
 }
 
-/// Median MLUPS of `reps` timed blocks after one warm-up block (AA kernel if `aa`).
-fn lbm_mlups<T: Real>(nx: usize, ny: usize, reps: usize, aa: bool) -> Result<f64> {
+/// One kernel measured against its traffic ceiling, repetition by repetition.
+struct Measured {
+    /// Median MLUPS of the kernel.
+    mlups: f64,
+    /// Median node-update rate of the ceiling (MLUPS-equivalent).
+    ceiling: f64,
+    /// Median over repetitions of kernel / ceiling, each pair timed back to back, so that a
+    /// change of load on the shared machine hits both sides of a ratio alike.
+    ratio: f64,
+}
+
+/// The kernel (AA if `aa`, else two-array) for `reps` timed blocks after one warm-up block, each
+/// followed by one block of its ceiling on 9 arrays of the same size (64-byte aligned): an
+/// in-place update (AA traffic) or a copy to 9 other arrays (two-array traffic, write-allocate
+/// included). Only the kernel measured and its ceiling hold memory at a time (4096² f64 is
+/// 1.2 GB per population array).
+fn measure<T: Real>(nx: usize, ny: usize, reps: usize, aa: bool) -> Result<Measured> {
+    const CHUNK: usize = 1 << 14;
+    let n = nx * ny;
     let mut fluid = Fluid::<D2Q9, T>::new(Domain::periodic([nx, ny, 1]), Vec::new());
     // relaxation rate 1.8 as in lbmpy_bench.py; small perturbation so nothing is trivially constant
     fluid.init_equilibrium(|p| {
@@ -59,14 +85,20 @@ fn lbm_mlups<T: Real>(nx: usize, ny: usize, reps: usize, aa: bool) -> Result<f64
         force: [0.0; 3],
         limits: Limits::default(),
     };
-    // only the kernel measured allocates its scratch (4096² f64 is 1.2 GB per population array)
     let (mut two, mut st_aa) = if aa {
         (None, Some(StepperAa::new(&mut fluid, settings)?))
     } else {
         (Some(Stepper::new(&fluid, settings)?), None)
     };
-    let steps = steps_for(nx * ny) & !1;
-    let mut rates = Vec::new();
+    let mut src: Vec<_> = (0..Q).map(|i| aligned(n, T::from_f64(1.0 + i as f64))).collect();
+    let mut dst: Vec<_> = if aa {
+        Vec::new()
+    } else {
+        (0..Q).map(|_| aligned(n, T::default())).collect()
+    };
+    let scale = T::from_f64(0.999);
+    let steps = steps_for(n) & !1;
+    let (mut rates, mut ceils, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
     for rep in 0..=reps {
         let t = Instant::now();
         for _ in 0..steps {
@@ -76,47 +108,45 @@ fn lbm_mlups<T: Real>(nx: usize, ny: usize, reps: usize, aa: bool) -> Result<f64
                 (None, None) => unreachable!(),
             }
         }
+        let rate = (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6;
+        let t = Instant::now();
+        for _ in 0..steps {
+            if aa {
+                for (arr, o) in src.iter_mut() {
+                    arr[*o..*o + n]
+                        .par_chunks_mut(CHUNK)
+                        .for_each(|x| x.iter_mut().for_each(|v| *v = *v * scale));
+                }
+            } else {
+                for ((d, od), (s, os)) in dst.iter_mut().zip(&src) {
+                    d[*od..*od + n]
+                        .par_chunks_mut(CHUNK)
+                        .zip(s[*os..*os + n].par_chunks(CHUNK))
+                        .for_each(|(d, s)| d.copy_from_slice(s));
+                }
+            }
+        }
+        let ceil = (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6;
         if rep > 0 {
-            rates.push((nx * ny * steps) as f64 / t.elapsed().as_secs_f64() / 1e6);
+            rates.push(rate);
+            ceils.push(ceil);
+            ratios.push(rate / ceil);
         }
     }
-    Ok(median(&rates))
+    std::hint::black_box((&src, &dst));
+    Ok(Measured {
+        mlups: median(&rates),
+        ceiling: median(&ceils),
+        ratio: median(&ratios),
+    })
 }
 
-/// Median node-update rates (MLUPS-equivalent) of the two traffic ceilings on 9 arrays of n values.
-fn ceilings<T: Real>(n: usize, reps: usize) -> (f64, f64) {
-    const CHUNK: usize = 1 << 14;
-    let a: Vec<Vec<T>> = (0..Q).map(|i| vec![T::from_f64(1.0 + i as f64); n]).collect();
-    let mut b: Vec<Vec<T>> = (0..Q).map(|_| vec![T::default(); n]).collect();
-    let mut c = a.clone();
-    let steps = steps_for(n);
-    let s = T::from_f64(0.999);
-    let (mut two, mut inplace) = (Vec::new(), Vec::new());
-    for rep in 0..=reps {
-        let t = Instant::now();
-        for _ in 0..steps {
-            for (d, s) in b.iter_mut().zip(&a) {
-                d.par_chunks_mut(CHUNK)
-                    .zip(s.par_chunks(CHUNK))
-                    .for_each(|(d, s)| d.copy_from_slice(s));
-            }
-        }
-        let t_two = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        for _ in 0..steps {
-            for arr in c.iter_mut() {
-                arr.par_chunks_mut(CHUNK)
-                    .for_each(|x| x.iter_mut().for_each(|v| *v = *v * s));
-            }
-        }
-        let t_in = t.elapsed().as_secs_f64();
-        if rep > 0 {
-            two.push((n * steps) as f64 / t_two / 1e6);
-            inplace.push((n * steps) as f64 / t_in / 1e6);
-        }
-    }
-    std::hint::black_box((&b, &c));
-    (median(&two), median(&inplace))
+/// `n` values of `x` starting on a 64-byte boundary, as the kernel's arrays (`lbdem_lbm::layout`):
+/// the vector and the offset of the first value.
+fn aligned<T: Real>(n: usize, x: T) -> (Vec<T>, usize) {
+    let v = vec![x; n + 64 / std::mem::size_of::<T>()];
+    let off = v.as_ptr().align_offset(64);
+    (v, off)
 }
 
 /// lbmpy's median MLUPS for one configuration, or None (with a note) if it cannot run.
@@ -153,31 +183,43 @@ fn lbmpy(nx: usize, ny: usize, precision: &str, threads: usize) -> Option<f64> {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
-    let sizes: &[(usize, usize)] = if a.quick {
-        &[(256, 192)]
+    let mut sizes: Vec<(usize, usize)> = if a.quick {
+        vec![(256, 192)]
     } else {
-        &[(256, 192), (1024, 1024), (4096, 4096)]
+        vec![(256, 192), (1024, 1024), (4096, 4096)]
     };
+    // LBDEM_BENCH_LBM_SIZE=1024x1024 runs one size only (to repeat a case on a busy machine)
+    if let Ok(v) = std::env::var("LBDEM_BENCH_LBM_SIZE") {
+        let (x, y) = v
+            .split_once('x')
+            .and_then(|(x, y)| Some((x.parse().ok()?, y.parse().ok()?)))
+            .with_context(|| format!("LBDEM_BENCH_LBM_SIZE = {v:?}: expected NXxNY, e.g. 1024x1024"))?;
+        sizes = vec![(x, y)];
+    }
+    println!(
+        "lbm: D2Q9 BGK (lbmpy: SRT), relaxation rate 1.8, periodic; AA in-place kernels on both sides; \
+         ceilings = 9-array updates of the same size measured in this run"
+    );
     let mut rows = Vec::new();
-    for &(nx, ny) in sizes {
+    for &(nx, ny) in &sizes {
         for precision in ["f64", "f32"] {
             for threads in [1, 2] {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
-                let (mlups, m2, (c2, ci)) = pool.install(|| -> Result<_> {
+                let (aa, two) = pool.install(|| -> Result<_> {
                     Ok(if precision == "f64" {
                         (
-                            lbm_mlups::<f64>(nx, ny, a.reps, true)?,
-                            lbm_mlups::<f64>(nx, ny, a.reps, false)?,
-                            ceilings::<f64>(nx * ny, a.reps),
+                            measure::<f64>(nx, ny, a.reps, true)?,
+                            measure::<f64>(nx, ny, a.reps, false)?,
                         )
                     } else {
                         (
-                            lbm_mlups::<f32>(nx, ny, a.reps, true)?,
-                            lbm_mlups::<f32>(nx, ny, a.reps, false)?,
-                            ceilings::<f32>(nx * ny, a.reps),
+                            measure::<f32>(nx, ny, a.reps, true)?,
+                            measure::<f32>(nx, ny, a.reps, false)?,
                         )
                     })
                 })?;
+                let (mlups, m2, c2, ci) = (aa.mlups, two.mlups, two.ceiling, aa.ceiling);
+                let bytes = if precision == "f64" { 8 } else { 4 };
                 let peer = if a.peer {
                     lbmpy(nx, ny, precision, threads)
                 } else {
@@ -192,15 +234,17 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                     mlups_two_array: m2,
                     ceiling_two_array: c2,
                     ceiling_in_place: ci,
-                    ratio_in_place: mlups / ci,
-                    ratio_two_array: m2 / c2,
+                    ceiling_in_place_gbs: ci * 1e6 * (2 * Q * bytes) as f64 / 1e9,
+                    ratio_in_place: aa.ratio,
+                    ratio_two_array: two.ratio,
                     lbmpy_mlups: peer,
                     ratio_lbmpy: peer.map(|p| mlups / p),
                 };
                 println!(
                     "lbm D2Q9 BGK {nx}x{ny} {precision} t={threads}: AA {mlups:6.1} MLUPS = {:3.0}% of in-place \
-                     ceiling {ci:6.1} | two-array {m2:6.1} = {:3.0}% of two-array ceiling {c2:6.1}{}",
+                     ceiling {ci:6.1} ({:4.1} GB/s) | two-array {m2:6.1} = {:3.0}% of two-array ceiling {c2:6.1}{}",
                     100.0 * row.ratio_in_place,
+                    row.ceiling_in_place_gbs,
                     100.0 * row.ratio_two_array,
                     match peer {
                         Some(p) => format!(" | lbmpy AA {p:7.1} -> lbdem/lbmpy {:.2}", mlups / p),

@@ -1,54 +1,115 @@
-//! Quick kernel throughput probe for development (the benchmark with ceilings and the peer is
-//! `lbdem bench lbm`): `cargo run --release -p lbdem-lbm --example mlups -- 1024 1024 f64 2 aa`.
+//! Development speed probe of one configuration (the benchmark proper, with the STREAM-style
+//! ceilings and the peer, is `lbdem bench lbm`). Each repetition times the kernel and, right
+//! after it, an in-place update of 9 arrays of the same size (the AA kernel's traffic), so that the
+//! printed ratio is robust to other load on the machine.
+//! `cargo run --release -p lbdem-lbm --example mlups -- NX NY f64|f32 THREADS [REPS] [bgk|trt] [aa|two] [WORK]`
 
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Limits, Real, Settings, Stepper, StepperAa};
+use rayon::prelude::*;
 use std::time::Instant;
 
-fn run<T: Real>(nx: usize, ny: usize, aa: bool, steps: usize) -> f64 {
-    let mut fl = Fluid::<D2Q9, T>::new(Domain::periodic([nx, ny, 1]), Vec::new());
-    let s = Settings {
-        collision: Collision::Bgk { tau: 1.0 / 1.8 },
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn run<T: Real>(nx: usize, ny: usize, reps: usize, collision: Collision, two: bool, work: usize) {
+    let n = nx * ny;
+    let mut fluid = Fluid::<D2Q9, T>::new(Domain::periodic([nx, ny, 1]), Vec::new());
+    fluid.init_equilibrium(|p| {
+        (
+            1.0 + 1e-4 * (((p[0] * 7 + p[1] * 13) % 17) as f64 / 17.0 - 0.5),
+            [0.0; 3],
+        )
+    });
+    let settings = Settings {
+        collision,
         force: [0.0; 3],
         limits: Limits::default(),
     };
-    let t;
-    if aa {
-        let mut st = StepperAa::new(&mut fl, s).unwrap();
-        st.step(&mut fl, None).unwrap();
-        st.step(&mut fl, None).unwrap();
-        t = Instant::now();
+    let steps = ((work / n).max(2)) & !1;
+    // 64-byte aligned, as the kernel's array and `lbdem bench lbm`'s ceilings
+    let mut c: Vec<(Vec<T>, usize)> = (0..9)
+        .map(|i| {
+            let v = vec![T::from_f64(1.0 + i as f64); n + 16];
+            let off = v.as_ptr().align_offset(64);
+            (v, off)
+        })
+        .collect();
+    let s = T::from_f64(0.999);
+    let mut ceiling = || {
+        let t = Instant::now();
         for _ in 0..steps {
-            st.step(&mut fl, None).unwrap();
+            for (arr, o) in c.iter_mut() {
+                arr[*o..*o + n]
+                    .par_chunks_mut(1 << 14)
+                    .for_each(|x| x.iter_mut().for_each(|v| *v = *v * s));
+            }
         }
+        (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6
+    };
+    let (mut two_st, mut aa_st) = if two {
+        (Some(Stepper::new(&fluid, settings).unwrap()), None)
     } else {
-        let mut st = Stepper::new(&fl, s).unwrap();
-        st.step(&mut fl, None).unwrap();
-        t = Instant::now();
+        (None, Some(StepperAa::new(&mut fluid, settings).unwrap()))
+    };
+    let (mut rates, mut ceils, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+    for rep in 0..=reps {
+        let t = Instant::now();
         for _ in 0..steps {
-            st.step(&mut fl, None).unwrap();
+            match (aa_st.as_mut(), two_st.as_mut()) {
+                (Some(a), _) => a.step(&mut fluid, None).unwrap(),
+                (None, Some(b)) => b.step(&mut fluid, None).unwrap(),
+                _ => unreachable!(),
+            }
+        }
+        let r = (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6;
+        let cl = ceiling();
+        if rep > 0 {
+            rates.push(r);
+            ceils.push(cl);
+            ratios.push(r / cl);
         }
     }
-    (nx * ny * steps) as f64 / t.elapsed().as_secs_f64() / 1e6
+    println!(
+        "{nx}x{ny} {} {} t={}: {:.1} MLUPS (best {:.1}), in-place ceiling {:.1} (best {:.1}), ratio {:.0}% (median of {reps}; ratios {:?})",
+        T::NAME,
+        if two { "two-array" } else { "AA" },
+        rayon::current_num_threads(),
+        median(rates.clone()),
+        rates.iter().cloned().fold(0.0, f64::max),
+        median(ceils.clone()),
+        ceils.iter().cloned().fold(0.0, f64::max),
+        100.0 * median(ratios.clone()),
+        ratios.iter().map(|r| (100.0 * r).round()).collect::<Vec<_>>()
+    );
 }
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let nx: usize = a.get(1).map_or(1024, |s| s.parse().unwrap());
     let ny: usize = a.get(2).map_or(1024, |s| s.parse().unwrap());
-    let f32s = a.get(3).is_some_and(|s| s == "f32");
+    let prec = a.get(3).map_or("f64", |s| s.as_str());
     let threads: usize = a.get(4).map_or(1, |s| s.parse().unwrap());
-    let aa = a.get(5).is_none_or(|s| s == "aa");
-    let steps = (100_000_000 / (nx * ny)).max(2) & !1;
+    let reps: usize = a.get(5).map_or(5, |s| s.parse().unwrap());
+    let collision = match a.get(6).map_or("bgk", |s| s.as_str()) {
+        "trt" => Collision::Trt {
+            tau: 1.0 / 1.8,
+            magic: 0.25,
+        },
+        _ => Collision::Bgk { tau: 1.0 / 1.8 },
+    };
+    let two = a.get(7).is_some_and(|s| s == "two");
+    let work: usize = a.get(8).map_or(60_000_000, |s| s.parse().unwrap());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
-    let m = pool.install(|| {
-        if f32s {
-            run::<f32>(nx, ny, aa, steps)
+    pool.install(|| {
+        if prec == "f32" {
+            run::<f32>(nx, ny, reps, collision, two, work)
         } else {
-            run::<f64>(nx, ny, aa, steps)
+            run::<f64>(nx, ny, reps, collision, two, work)
         }
     });
-    println!("{nx}x{ny} f32={f32s} threads={threads} aa={aa}: {m:.1} MLUPS");
 }

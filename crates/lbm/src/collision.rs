@@ -12,6 +12,14 @@ use crate::lattice::{CS2, Lattice, QMAX};
 use crate::real::Real;
 use serde::{Deserialize, Serialize};
 
+/// Repeat a block once per listed index (a literal bound to `$k`): loops over the directions
+/// whose velocity must be a compile-time constant inside the body.
+macro_rules! unroll {
+    ($k:ident in [$($n:literal),*] $body:block) => {
+        $( { let $k: usize = $n; $body } )*
+    };
+}
+
 /// The collision operator of a run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
@@ -68,6 +76,10 @@ pub struct CollideParams<T> {
     pub force_m: T,
     /// Uniform body force density (lattice units).
     pub force: [T; 3],
+    /// ω⁺ = ω⁻ (BGK): `collide_block` takes the single-rate path `bgk_block`.
+    pub bgk: bool,
+    /// 1 − ω (BGK path).
+    pub keep: T,
 }
 
 impl<T: Real> CollideParams<T> {
@@ -79,6 +91,8 @@ impl<T: Real> CollideParams<T> {
             force_p: T::from_f64(1.0 - 0.5 * wp),
             force_m: T::from_f64(1.0 - 0.5 * wm),
             force: force.map(T::from_f64),
+            bgk: wp == wm,
+            keep: T::from_f64(1.0 - wp),
         })
     }
 }
@@ -87,6 +101,8 @@ impl<T: Real> CollideParams<T> {
 pub struct Moments<T, const W: usize> {
     pub rho: [T; W],
     pub u: [[T; W]; 3],
+    /// |u|² as the collision computed it (the kernels' range check uses it).
+    pub usq: [T; W],
 }
 
 /// Collide `W` nodes held in `f[i][w]` (pre-collision in, post-collision out), uniform force.
@@ -95,12 +111,17 @@ pub struct Moments<T, const W: usize> {
 /// with the equilibrium of Su Eq. 7 / Leonardi Eq. 13 and the Guo source
 /// S_i = w_i[3(c_i − u) + 9 c_i (c_i·u)]·F (Leonardi Eq. 16) split into its even and odd parts.
 /// Written with the node index innermost over fixed-size local arrays so that it vectorises.
-#[inline(always)]
 /// `FORCED = false` drops the force terms at compile time (the result is the same for F = 0).
+/// With equal rates (BGK) the single-rate form `bgk_block` is taken instead: the same operator
+/// with about half the arithmetic (no even/odd split).
+#[inline(always)]
 pub fn collide_block<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
     f: &mut [[T; W]; QMAX],
     p: &CollideParams<T>,
 ) -> Moments<T, W> {
+    if p.bgk {
+        return bgk_block::<L, T, W, FORCED>(f, p);
+    }
     let zero = T::default();
     let half = T::from_f64(0.5);
     let one = T::from_f64(1.0);
@@ -189,7 +210,151 @@ pub fn collide_block<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
             f[o][w] = ns - na;
         }
     }
-    Moments { rho, u }
+    Moments { rho, u, usq }
+}
+
+/// ρ, u = (Σ f c + F/2)/ρ (Leonardi Eqs. 9, 17) and |u|² of a block. Velocity components are
+/// summed with additions and subtractions only (c_ia ∈ {−1, 0, 1} is a compile-time constant).
+#[inline(always)]
+fn moments<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
+    f: &[[T; W]; QMAX],
+    p: &CollideParams<T>,
+) -> Moments<T, W> {
+    let zero = T::default();
+    let half = T::from_f64(0.5);
+    let one = T::from_f64(1.0);
+    let mut rho = [zero; W];
+    let mut j = [[zero; W]; 3];
+    // unrolled so that c_i is a compile-time constant and the matches fold away
+    unroll!(i in [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18] {
+        if i < L::Q {
+            let c = L::C[i];
+            for w in 0..W {
+                rho[w] += f[i][w];
+            }
+            unroll!(a in [0, 1, 2] {
+                if a < L::D {
+                    if c[a] == 1 {
+                        for w in 0..W {
+                            j[a][w] += f[i][w];
+                        }
+                    } else if c[a] == -1 {
+                        for w in 0..W {
+                            j[a][w] = j[a][w] - f[i][w];
+                        }
+                    }
+                }
+            });
+        }
+    });
+    let mut u = [[zero; W]; 3];
+    let mut usq = [zero; W];
+    for w in 0..W {
+        let inv = one / rho[w];
+        for a in 0..L::D {
+            u[a][w] = if FORCED {
+                (j[a][w] + half * p.force[a]) * inv
+            } else {
+                j[a][w] * inv
+            };
+            usq[w] = u[a][w].mul_add(u[a][w], usq[w]);
+        }
+    }
+    Moments { rho, u, usq }
+}
+
+/// c_i · u for a compile-time c_i with components in {−1, 0, 1}: additions only.
+#[inline(always)]
+fn c_dot<T: Real>(c: [i32; 3], u: [T; 3]) -> T {
+    let mut s: Option<T> = None;
+    unroll!(a in [0, 1, 2] {
+        let v = match c[a] {
+            1 => Some(u[a]),
+            -1 => Some(-u[a]),
+            _ => None,
+        };
+        if let Some(v) = v {
+            s = Some(match s {
+                None => v,
+                Some(acc) => acc + v,
+            });
+        }
+    });
+    s.unwrap_or_default()
+}
+
+/// BGK collision of a block, f_i ← (1 − ω) f_i + ω f_i^eq + (1 − ω/2) S_i (Leonardi Eqs. 11, 15-16),
+/// written per opposite pair (i, ī) as f_i^eq = A + B, f_ī^eq = A − B with the even part
+/// A = w_i ρ (1 + 4.5 (c_i·u)² − 1.5 u²) and the odd part B = 3 w_i ρ c_i·u (Su Eq. 7), with ω
+/// folded into the weights and fused multiply-adds: about 65 operations per node in D2Q9 instead
+/// of the 130 of the TRT form. The Guo source splits the same way (even part w_i(9 (c_i·u)(c_i·F)
+/// − 3 u·F), odd part 3 w_i c_i·F).
+#[inline(always)]
+pub fn bgk_block<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
+    f: &mut [[T; W]; QMAX],
+    p: &CollideParams<T>,
+) -> Moments<T, W> {
+    let m = moments::<L, T, W, FORCED>(f, p);
+    let one = T::from_f64(1.0);
+    let three = T::from_f64(3.0);
+    let c45 = T::from_f64(4.5);
+    let m15 = T::from_f64(-1.5);
+    let nine = T::from_f64(9.0);
+    let omega = p.omega_p;
+    let keep = p.keep;
+    // 1 − 1.5 u² and (forced) u·F, shared by every direction
+    let mut base = [T::default(); W];
+    let mut uf = [T::default(); W];
+    for w in 0..W {
+        base[w] = m15.mul_add(m.usq[w], one);
+        if FORCED {
+            for a in 0..L::D {
+                uf[w] = m.u[a][w].mul_add(p.force[a], uf[w]);
+            }
+        }
+    }
+    {
+        let w0 = T::from_f64(L::W[0]);
+        let ow0 = omega * w0;
+        let src0 = p.force_p * (-(w0 * three));
+        for w in 0..W {
+            let mut a = (ow0 * m.rho[w]) * base[w];
+            if FORCED {
+                a = src0.mul_add(uf[w], a);
+            }
+            f[0][w] = keep.mul_add(f[0][w], a);
+        }
+    }
+    // unrolled (see `moments`)
+    unroll!(h in [0, 1, 2, 3, 4, 5, 6, 7, 8] {
+        if h < L::HALF.len() {
+        let i = L::HALF[h];
+        let o = L::OPP[i];
+        let c = L::C[i];
+        let wi = T::from_f64(L::W[i]);
+        let owi = omega * wi;
+        let owi3 = owi * three;
+        let cf = c_dot(c, p.force);
+        // forcing: even part force_p w_i (9 cu cf − 3 uf), odd part force_p 3 w_i cf
+        let s9 = p.force_p * wi * nine * cf;
+        let s3 = p.force_p * wi * three;
+        let s_odd = s3 * cf;
+        for w in 0..W {
+            let cu = c_dot(c, [m.u[0][w], m.u[1][w], m.u[2][w]]);
+            let rho = m.rho[w];
+            let mut a = (owi * rho) * (c45 * cu).mul_add(cu, base[w]);
+            let mut b = (owi3 * rho) * cu;
+            if FORCED {
+                a = s9.mul_add(cu, a);
+                a = (-s3).mul_add(uf[w], a);
+                b += s_odd;
+            }
+            f[i][w] = keep.mul_add(f[i][w], a + b);
+            f[o][w] = keep.mul_add(f[o][w], a - b);
+        }
+        }
+    });
+    m
 }
 
 /// Equilibrium populations (Su Eq. 7) for one node.

@@ -12,14 +12,34 @@ use crate::plan::{Plan, Upstream, neighbour};
 use crate::real::Real;
 use crate::zouhe;
 
-/// Block width of the fast path (16 f32 or 2x8 f64 lanes of AVX-512).
-pub const W: usize = 16;
+/// Block width of the fast path for values of `T`: two AVX-512 registers per quantity, 32 f32 or
+/// 16 f64 nodes. One register per quantity (16 f32, 8 f64) or four (32 f64) ran 15-40 % slower in
+/// cache (256x192, `examples/mlups.rs`): two independent chains hide the latency of the
+/// arithmetic without spilling the 9 populations.
+#[inline(always)]
+pub const fn wide<T>() -> usize {
+    if std::mem::size_of::<T>() == 4 { 32 } else { 16 }
+}
 
 /// Raw pointer that may cross threads; every use writes only rows that one task owns.
 #[derive(Clone, Copy)]
 pub struct SyncPtr<T>(pub *mut T);
 unsafe impl<T> Send for SyncPtr<T> {}
 unsafe impl<T> Sync for SyncPtr<T> {}
+
+/// v + d on a periodic axis of n nodes, d in {-1, 0, 1} (compares, not a division: this runs
+/// 2Q times per row).
+#[inline(always)]
+pub fn wrap(v: usize, d: i32, n: usize) -> usize {
+    let s = v as isize + d as isize;
+    if s < 0 {
+        (s + n as isize) as usize
+    } else if s >= n as isize {
+        (s - n as isize) as usize
+    } else {
+        s as usize
+    }
+}
 
 /// Accepted range of the macroscopic fields; outside it the run is stopped (see `Stepper`).
 #[derive(Clone, Copy, Debug)]
@@ -41,6 +61,40 @@ impl Default for Limits {
     }
 }
 
+impl Limits {
+    /// The limits in the storage precision: the per-node check is then three vector compares on
+    /// ρ and |u|² as the collision computed them (a NaN fails every compare, so it is caught).
+    pub fn in_precision<T: Real>(&self) -> LimitsT<T> {
+        LimitsT {
+            rho_min: T::from_f64(self.rho_min),
+            rho_max: T::from_f64(self.rho_max),
+            usq_max: T::from_f64(self.u_max * self.u_max),
+        }
+    }
+}
+
+/// `Limits` rounded to the storage precision (see `Limits::in_precision`).
+#[derive(Clone, Copy, Debug)]
+pub struct LimitsT<T> {
+    pub rho_min: T,
+    pub rho_max: T,
+    pub usq_max: T,
+}
+
+impl<T: Real> LimitsT<T> {
+    /// True when the node is within the limits (false for NaN).
+    #[inline(always)]
+    pub fn within(&self, rho: T, usq: T) -> bool {
+        (rho > self.rho_min) & (rho < self.rho_max) & (usq < self.usq_max)
+    }
+
+    /// Bit w set when node w of a block (B <= 32) is outside the limits or not finite.
+    #[inline(always)]
+    pub fn bad_lanes<const B: usize>(&self, rho: &[T; B], usq: &[T; B]) -> u32 {
+        T::bad_block(rho, usq, self.rho_min, self.rho_max, self.usq_max)
+    }
+}
+
 /// Where the kernel writes ρ and u (f64, node order; u interleaved xyz) when asked.
 #[derive(Clone, Copy)]
 pub struct MacroOut {
@@ -57,15 +111,8 @@ pub struct Ctx<'a, T> {
     pub params: CollideParams<T>,
     /// Motion of each obstacle, then of the six faces (velocity only).
     pub motions: &'a [Motion],
-    pub limits: Limits,
+    pub limits: LimitsT<T>,
     pub out: Option<MacroOut>,
-}
-
-#[inline(always)]
-fn ok<T: Real>(rho: T, u: [T; 3], l: &Limits) -> bool {
-    let usq = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).to_f64();
-    let r = rho.to_f64();
-    r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max
 }
 
 /// Update row `r` (y + ny z). Returns false if a node left the limits (or is not finite).
@@ -84,45 +131,40 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
     let mut up_off = [0usize; QMAX];
     for (i, off) in up_off.iter_mut().enumerate().take(L::Q) {
         let c = L::C[i];
-        let ys = (y as i64 - c[1] as i64).rem_euclid(ny as i64) as usize;
-        let zs = (z as i64 - c[2] as i64).rem_euclid(dom.n[2] as i64) as usize;
+        let ys = wrap(y, -c[1], ny);
+        let zs = wrap(z, -c[2], dom.n[2]);
         *off = i * n + (ys + ny * zs) * nx;
     }
     let plan = ctx.plan;
-    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
-    let mut f = [[T::default(); W]; QMAX];
+    // pull from x - c_i of the upstream row, write slot i of this row
+    let mut src = [0usize; QMAX];
+    let mut dst = [0usize; QMAX];
+    for i in 0..L::Q {
+        src[i] = up_off[i].wrapping_sub(L::C[i][0] as isize as usize);
+        dst[i] = i * n + row_off;
+    }
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
-        let (x0, x1) = (x0 as usize, x1 as usize);
-        let mut xb = x0;
-        while xb + W <= x1 {
-            for i in 0..L::Q {
-                let s = (up_off[i] as isize + xb as isize - L::C[i][0] as isize) as usize;
-                f[i].copy_from_slice(&ctx.src[s..s + W]);
+        good &= unsafe {
+            if wide::<T>() == 32 {
+                span::<L, T, F, 32>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
+            } else {
+                span::<L, T, F, 16>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
             }
-            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
-            for i in 0..L::Q {
-                // SAFETY: row r is ours; i*n + row_off + xb + W <= Q n.
-                unsafe {
-                    let d = ctx.dst.0.add(i * n + row_off + xb);
-                    std::ptr::copy_nonoverlapping(f[i].as_ptr(), d, W);
-                }
-            }
-            good &= finish_block::<T, W>(ctx, &m, row_off + xb, W);
-            xb += W;
+        };
+    }
+    // periodic x edges with only fluid neighbours: the fast path with a wrapped x
+    for &x in &plan.wraps[plan.wrap_start[r] as usize..plan.wrap_start[r + 1] as usize] {
+        let x = x as usize;
+        let mut f = [[T::default(); 1]; QMAX];
+        for i in 0..L::Q {
+            f[i][0] = ctx.src[up_off[i] + wrap(x, -L::C[i][0], nx)];
         }
-        while xb < x1 {
-            let mut f = [[T::default(); 1]; QMAX];
-            for i in 0..L::Q {
-                let s = (up_off[i] as isize + xb as isize - L::C[i][0] as isize) as usize;
-                f[i][0] = ctx.src[s];
-            }
-            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
-            for i in 0..L::Q {
-                unsafe { *ctx.dst.0.add(i * n + row_off + xb) = f[i][0] };
-            }
-            good &= finish_block::<T, 1>(ctx, &m, row_off + xb, 1);
-            xb += 1;
+        let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+        for i in 0..L::Q {
+            // SAFETY: row r is ours.
+            unsafe { *ctx.dst.0.add(i * n + row_off + x) = f[i][0] };
         }
+        good &= finish_block::<T, 1>(ctx, &m, row_off + x);
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
         good &= unsafe { general_node::<L, T, F>(ctx, [x as usize, y, z]) };
@@ -130,14 +172,77 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
     good
 }
 
+/// Nodes [x0, x1) of a fast span in blocks of `WB`, the rest in one block each of 16, 8, 4, 2, 1
+/// nodes at most (as `kernel_aa::run`).
+///
+/// # Safety
+/// As `block`.
 #[inline(always)]
-fn finish_block<T: Real, const B: usize>(ctx: &Ctx<T>, m: &Moments<T, B>, idx0: usize, count: usize) -> bool {
+unsafe fn span<L: Lattice, T: Real, const F: bool, const WB: usize>(
+    ctx: &Ctx<T>,
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x0: usize,
+    x1: usize,
+    row_off: usize,
+) -> bool {
     let mut good = true;
-    for w in 0..count {
-        good &= ok(m.rho[w], [m.u[0][w], m.u[1][w], m.u[2][w]], &ctx.limits);
+    // block scratch, reused (zeroing it per block would cost more than the loads)
+    let mut f = [[T::default(); WB]; QMAX];
+    let mut x = x0;
+    while x + WB <= x1 {
+        good &= unsafe { block::<L, T, WB, F>(ctx, &mut f, src, dst, x, row_off + x) };
+        x += WB;
     }
+    macro_rules! tail {
+        ($b:literal) => {
+            if $b < WB && $b <= x1 - x {
+                let mut g = [[T::default(); $b]; QMAX];
+                good &= unsafe { block::<L, T, $b, F>(ctx, &mut g, src, dst, x, row_off + x) };
+                x += $b;
+            }
+        };
+    }
+    tail!(16);
+    tail!(8);
+    tail!(4);
+    tail!(2);
+    tail!(1);
+    debug_assert_eq!(x, x1);
+    good
+}
+
+/// Pull `B` consecutive nodes from `src[i] + x`, collide, write `dst[i] + x`; false if a node left
+/// the limits.
+///
+/// # Safety
+/// `src[i] + x + B <= Q n` (fast spans only) and the destination nodes belong to the calling row.
+#[inline(always)]
+unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
+    ctx: &Ctx<T>,
+    f: &mut [[T; B]; QMAX],
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x: usize,
+    node: usize,
+) -> bool {
+    for i in 0..L::Q {
+        let s = src[i].wrapping_add(x);
+        f[i].copy_from_slice(&ctx.src[s..s + B]);
+    }
+    let m = collide_block::<L, T, B, F>(f, &ctx.params);
+    for i in 0..L::Q {
+        // SAFETY: caller's contract.
+        unsafe { std::ptr::copy_nonoverlapping(f[i].as_ptr(), ctx.dst.0.add(dst[i] + x), B) };
+    }
+    finish_block::<T, B>(ctx, &m, node)
+}
+
+#[inline(always)]
+fn finish_block<T: Real, const B: usize>(ctx: &Ctx<T>, m: &Moments<T, B>, idx0: usize) -> bool {
+    let good = ctx.limits.bad_lanes(&m.rho, &m.usq) == 0;
     if let Some(o) = ctx.out {
-        for w in 0..count {
+        for w in 0..B {
             let idx = idx0 + w;
             // SAFETY: node idx is in this task's row.
             unsafe {
@@ -214,5 +319,5 @@ unsafe fn general_node<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, p: [usi
     for i in 0..L::Q {
         unsafe { *ctx.dst.0.add(i * n + idx) = f[i][0] };
     }
-    finish_block::<T, 1>(ctx, &m, idx, 1)
+    finish_block::<T, 1>(ctx, &m, idx)
 }

@@ -14,8 +14,9 @@
 
 use crate::collision::{CollideParams, Moments, collide_block};
 use crate::domain::{Domain, FLUID, Motion};
-use crate::kernel::{Limits, MacroOut, SyncPtr, W};
+use crate::kernel::{LimitsT, MacroOut, SyncPtr, wide, wrap};
 use crate::lattice::{Lattice, QMAX};
+use crate::layout::Layout;
 use crate::plan::{Plan, Upstream, neighbour};
 use crate::real::Real;
 
@@ -25,42 +26,24 @@ pub type Bad = Option<(usize, f64, [f64; 3])>;
 pub struct CtxAa<'a, T> {
     pub dom: &'a Domain,
     pub plan: &'a Plan,
-    /// The single population array (read and written through raw pointers only).
+    /// The single population array (read and written through raw pointers only), in `layout`.
     pub f: SyncPtr<T>,
+    pub layout: Layout,
     pub params: CollideParams<T>,
     pub motions: &'a [Motion],
-    pub limits: Limits,
+    pub limits: LimitsT<T>,
     pub out: Option<MacroOut>,
 }
 
+/// Range check of a block of `B` nodes starting at node `idx0` (and the macroscopic output).
 #[inline(always)]
-fn check<T: Real, const B: usize>(
-    ctx: &CtxAa<T>,
-    m: &Moments<T, B>,
-    idx0: usize,
-    count: usize,
-    bad: &mut Bad,
-) {
-    let l = &ctx.limits;
-    let mut any = false;
-    for w in 0..count {
-        let usq = (m.u[0][w] * m.u[0][w] + m.u[1][w] * m.u[1][w] + m.u[2][w] * m.u[2][w]).to_f64();
-        let r = m.rho[w].to_f64();
-        any |= !(r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max);
-    }
-    if any && bad.is_none() {
-        for w in 0..count {
-            let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
-            let r = m.rho[w].to_f64();
-            let usq = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-            if !(r > l.rho_min && r < l.rho_max && usq < l.u_max * l.u_max) {
-                *bad = Some(((idx0 + w) % ctx.dom.n[0], r, u));
-                break;
-            }
-        }
+fn check<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize, bad: &mut Bad) {
+    let bits = ctx.limits.bad_lanes(&m.rho, &m.usq);
+    if bits != 0 && bad.is_none() {
+        *bad = first_bad(ctx, m, idx0, bits);
     }
     if let Some(o) = ctx.out {
-        for w in 0..count {
+        for w in 0..B {
             let idx = idx0 + w;
             // SAFETY: node idx belongs to the calling row.
             unsafe {
@@ -73,59 +56,120 @@ fn check<T: Real, const B: usize>(
     }
 }
 
+/// The first node of a block flagged in `bits`, for the diagnosis (rare: kept out of line).
+#[cold]
+#[inline(never)]
+fn first_bad<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize, bits: u32) -> Bad {
+    let w = bits.trailing_zeros() as usize;
+    let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
+    Some(((idx0 + w) % ctx.dom.n[0], m.rho[w].to_f64(), u))
+}
+
 /// Even step of row `r`: local collide, slot i -> slot opp(i), over every fluid run of the row.
 ///
 /// # Safety
-/// `ctx.f` must hold Q n values; no other thread may touch the nodes of row `r`.
+/// `ctx.f` must hold Q `ctx.layout.stride` values; no other thread may touch the nodes of row `r`.
 pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
     let dom = ctx.dom;
     let nx = dom.n[0];
-    let n = dom.len();
+    let n = ctx.layout.stride;
+    // node index of x = 0 (macroscopic output, diagnosis) and its slot in the padded array
     let row_off = r * nx;
+    let slot_off = r * ctx.layout.nxp;
     let mut bad = None;
-    let kind = &dom.kind[row_off..row_off + nx];
-    let mut x = 0;
-    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
-    let mut f = [[T::default(); W]; QMAX];
-    while x < nx {
-        if kind[x] != FLUID {
-            x += 1;
-            continue;
-        }
-        let x0 = x;
-        while x < nx && kind[x] == FLUID {
-            x += 1;
-        }
-        let mut xb = x0;
-        while xb + W <= x {
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                // SAFETY: in bounds, own nodes.
-                unsafe {
-                    std::ptr::copy_nonoverlapping(ctx.f.0.add(i * n + row_off + xb), fi.as_mut_ptr(), W)
-                };
-            }
-            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                let o = L::OPP[i];
-                unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(o * n + row_off + xb), W) };
-            }
-            check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
-            xb += W;
-        }
-        while xb < x {
-            let mut f = [[T::default(); 1]; QMAX];
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                fi[0] = unsafe { *ctx.f.0.add(i * n + row_off + xb) };
-            }
-            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe { *ctx.f.0.add(L::OPP[i] * n + row_off + xb) = fi[0] };
-            }
-            check::<T, 1>(ctx, &m, row_off + xb, 1, &mut bad);
-            xb += 1;
-        }
+    let plan = ctx.plan;
+    // slot i -> slot opp(i) of the same node
+    let mut src = [0usize; QMAX];
+    let mut dst = [0usize; QMAX];
+    for i in 0..L::Q {
+        src[i] = i * n + slot_off;
+        dst[i] = L::OPP[i] * n + slot_off;
+    }
+    for &(x0, x1) in &plan.runs[plan.run_start[r] as usize..plan.run_start[r + 1] as usize] {
+        unsafe { run::<L, T, F>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     bad
+}
+
+/// Gather `B` consecutive nodes from slots `src[i] + x`, collide, scatter to `dst[i] + x`, check.
+///
+/// # Safety
+/// The slots must be in bounds and belong to nodes of the calling row (module doc).
+#[inline(always)]
+unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
+    ctx: &CtxAa<T>,
+    f: &mut [[T; B]; QMAX],
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x: usize,
+    node: usize,
+    bad: &mut Bad,
+) {
+    for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+        unsafe { std::ptr::copy_nonoverlapping(ctx.f.0.add(src[i].wrapping_add(x)), fi.as_mut_ptr(), B) };
+    }
+    let m = collide_block::<L, T, B, F>(f, &ctx.params);
+    for (i, fi) in f.iter().enumerate().take(L::Q) {
+        unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(dst[i].wrapping_add(x)), B) };
+    }
+    check::<T, B>(ctx, &m, node, bad);
+}
+
+/// Nodes [x0, x1) of a row in blocks of `kernel::wide::<T>()` nodes (two AVX-512 registers per
+/// quantity), the rest in one block each of 16, 8, 4, 2 and 1 nodes at most (narrower vectors
+/// instead of up to 31 scalar nodes).
+///
+/// # Safety
+/// As `block`.
+#[inline(always)]
+unsafe fn run<L: Lattice, T: Real, const F: bool>(
+    ctx: &CtxAa<T>,
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x0: usize,
+    x1: usize,
+    node_off: usize,
+    bad: &mut Bad,
+) {
+    if wide::<T>() == 32 {
+        unsafe { run_w::<L, T, F, 32>(ctx, src, dst, x0, x1, node_off, bad) }
+    } else {
+        unsafe { run_w::<L, T, F, 16>(ctx, src, dst, x0, x1, node_off, bad) }
+    }
+}
+
+#[inline(always)]
+unsafe fn run_w<L: Lattice, T: Real, const F: bool, const WB: usize>(
+    ctx: &CtxAa<T>,
+    src: &[usize; QMAX],
+    dst: &[usize; QMAX],
+    x0: usize,
+    x1: usize,
+    node_off: usize,
+    bad: &mut Bad,
+) {
+    // block scratch, reused (zeroing it per block would cost more than the loads)
+    let mut f = [[T::default(); WB]; QMAX];
+    let mut x = x0;
+    while x + WB <= x1 {
+        unsafe { block::<L, T, WB, F>(ctx, &mut f, src, dst, x, node_off + x, bad) };
+        x += WB;
+    }
+    macro_rules! tail {
+        ($b:literal) => {
+            if $b < WB && $b <= x1 - x {
+                let mut g = [[T::default(); $b]; QMAX];
+                unsafe { block::<L, T, $b, F>(ctx, &mut g, src, dst, x, node_off + x, bad) };
+                x += $b;
+            }
+        };
+    }
+    tail!(16);
+    tail!(8);
+    tail!(4);
+    tail!(2);
+    tail!(1);
+    debug_assert_eq!(x, x1);
 }
 
 /// Odd step of row `r`: gather from neighbours, collide, scatter to neighbours.
@@ -136,56 +180,40 @@ pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: us
 pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
     let dom = ctx.dom;
     let [nx, ny, nz] = dom.n;
-    let n = dom.len();
+    let n = ctx.layout.stride;
+    let nxp = ctx.layout.nxp;
     let (y, z) = (r % ny, r / ny);
     let row_off = r * nx;
     let mut bad = None;
     let mut up = [0usize; QMAX];
     let mut down = [0usize; QMAX];
+    // the same without the x offset (periodic-edge nodes add their wrapped x)
+    let mut up_row = [0usize; QMAX];
+    let mut down_row = [0usize; QMAX];
     for i in 0..L::Q {
         let c = L::C[i];
-        let row_of = |s: i64| {
-            let ys = (y as i64 + s * c[1] as i64).rem_euclid(ny as i64) as usize;
-            let zs = (z as i64 + s * c[2] as i64).rem_euclid(nz as i64) as usize;
-            (ys + ny * zs) * nx
-        };
+        let row_of = |s: i32| (wrap(y, s * c[1], ny) + ny * wrap(z, s * c[2], nz)) * nxp;
         // read slot opp(i) of y - c_i; write slot i of y + c_i
-        up[i] = (L::OPP[i] * n + row_of(-1)).wrapping_sub(c[0] as isize as usize);
-        down[i] = (i * n + row_of(1)).wrapping_add(c[0] as isize as usize);
+        up_row[i] = L::OPP[i] * n + row_of(-1);
+        down_row[i] = i * n + row_of(1);
+        up[i] = up_row[i].wrapping_sub(c[0] as isize as usize);
+        down[i] = down_row[i].wrapping_add(c[0] as isize as usize);
     }
     let plan = ctx.plan;
-    // block scratch, reused (zeroing 2.4 kB per block would cost more than the loads)
-    let mut f = [[T::default(); W]; QMAX];
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
-        let (x0, x1) = (x0 as usize, x1 as usize);
-        let mut xb = x0;
-        while xb + W <= x1 {
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                unsafe {
-                    std::ptr::copy_nonoverlapping(ctx.f.0.add(up[i].wrapping_add(xb)), fi.as_mut_ptr(), W)
-                };
-            }
-            let m = collide_block::<L, T, W, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe {
-                    std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(down[i].wrapping_add(xb)), W)
-                };
-            }
-            check::<T, W>(ctx, &m, row_off + xb, W, &mut bad);
-            xb += W;
+        unsafe { run::<L, T, F>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
+    }
+    for &x in &plan.wraps[plan.wrap_start[r] as usize..plan.wrap_start[r + 1] as usize] {
+        let x = x as usize;
+        let mut f = [[T::default(); 1]; QMAX];
+        for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
+            fi[0] = unsafe { *ctx.f.0.add(up_row[i] + wrap(x, -L::C[i][0], nx)) };
         }
-        while xb < x1 {
-            let mut f = [[T::default(); 1]; QMAX];
-            for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-                fi[0] = unsafe { *ctx.f.0.add(up[i].wrapping_add(xb)) };
-            }
-            let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
-            for (i, fi) in f.iter().enumerate().take(L::Q) {
-                unsafe { *ctx.f.0.add(down[i].wrapping_add(xb)) = fi[0] };
-            }
-            check::<T, 1>(ctx, &m, row_off + xb, 1, &mut bad);
-            xb += 1;
+        let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+        for (i, fi) in f.iter().enumerate().take(L::Q) {
+            unsafe { *ctx.f.0.add(down_row[i] + wrap(x, L::C[i][0], nx)) = fi[0] };
         }
+        check::<T, 1>(ctx, &m, row_off + x, &mut bad);
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
         unsafe { odd_general::<L, T, F>(ctx, [x as usize, y, z], &mut bad) };
@@ -208,7 +236,7 @@ fn wall_velocity(ctx: &CtxAa<impl Real>, p: [usize; 3], c: [i32; 3], sign: f64, 
 
 unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [usize; 3], bad: &mut Bad) {
     let dom = ctx.dom;
-    let n = dom.len();
+    let lay = &ctx.layout;
     let idx = dom.index(p[0], p[1], p[2]);
     let n_obst = ctx.motions.len() - 6;
     let dotw = |i: usize, u: [f64; 3]| {
@@ -221,13 +249,13 @@ unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [us
         let c = L::C[i];
         // SAFETY (all raw accesses): indices in bounds; slots owned by this node.
         fi[0] = match neighbour(dom, p, [-c[0], -c[1], -c[2]]) {
-            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(L::OPP[i] * n + s) },
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(lay.slot(L::OPP[i], s)) },
             Upstream::Node(s) => {
                 let uw = wall_velocity(ctx, p, c, -1.0, s);
-                unsafe { *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, uw)) }
+                unsafe { *ctx.f.0.add(lay.slot(i, idx)) + T::from_f64(dotw(i, uw)) }
             }
             Upstream::Face(fc) => unsafe {
-                *ctx.f.0.add(i * n + idx) + T::from_f64(dotw(i, face_velocity(fc)))
+                *ctx.f.0.add(lay.slot(i, idx)) + T::from_f64(dotw(i, face_velocity(fc)))
             },
         };
     }
@@ -236,15 +264,15 @@ unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [us
         let c = L::C[i];
         let o = L::OPP[i];
         match neighbour(dom, p, c) {
-            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(i * n + s) = fi[0] },
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(lay.slot(i, s)) = fi[0] },
             Upstream::Node(s) => {
                 let uw = wall_velocity(ctx, p, c, 1.0, s);
-                unsafe { *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, uw)) }
+                unsafe { *ctx.f.0.add(lay.slot(o, idx)) = fi[0] + T::from_f64(dotw(o, uw)) }
             }
             Upstream::Face(fc) => unsafe {
-                *ctx.f.0.add(o * n + idx) = fi[0] + T::from_f64(dotw(o, face_velocity(fc)))
+                *ctx.f.0.add(lay.slot(o, idx)) = fi[0] + T::from_f64(dotw(o, face_velocity(fc)))
             },
         }
     }
-    check::<T, 1>(ctx, &m, idx, 1, bad);
+    check::<T, 1>(ctx, &m, idx, bad);
 }

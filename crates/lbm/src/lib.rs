@@ -16,6 +16,7 @@ pub mod domain;
 pub mod kernel;
 pub mod kernel_aa;
 pub mod lattice;
+pub mod layout;
 pub mod plan;
 pub mod real;
 pub mod stepper;

@@ -1,7 +1,9 @@
 //! Per-row work plan derived from the geometry: which runs of nodes take the branch-free fast
 //! path (fluid node whose every upstream neighbour is fluid and inside the box without an x wrap),
-//! which nodes need the general path (walls, obstacles, periodic x edges, Zou-He), and the list
-//! of boundary links used for the momentum-exchange force (Leonardi Eq. 21).
+//! which nodes sit on a periodic x edge with only fluid neighbours (a cheap path with wrapped
+//! indices), which nodes need the general path (walls, obstacles, Zou-He), the runs of fluid
+//! nodes of each row, and the list of boundary links used for the momentum-exchange force
+//! (Leonardi Eq. 21).
 
 use crate::domain::{Domain, FLUID, Face, NO_OBSTACLE};
 use crate::lattice::Lattice;
@@ -25,6 +27,12 @@ pub struct Plan {
     /// x of each general-path node, flat, same scheme.
     pub gen_start: Vec<u32>,
     pub gens: Vec<u32>,
+    /// x of each periodic-edge node whose every neighbour is a fluid node (through the x wrap).
+    pub wrap_start: Vec<u32>,
+    pub wraps: Vec<u32>,
+    /// Runs [x0, x1) of fluid nodes of each row (the AA kernel's local even step).
+    pub run_start: Vec<u32>,
+    pub runs: Vec<(u32, u32)>,
     pub links: Vec<Link>,
     pub fluid_nodes: usize,
 }
@@ -71,16 +79,23 @@ impl Plan {
         let mut plan = Plan {
             span_start: Vec::with_capacity(rows + 1),
             gen_start: Vec::with_capacity(rows + 1),
+            wrap_start: Vec::with_capacity(rows + 1),
+            run_start: Vec::with_capacity(rows + 1),
             ..Default::default()
         };
         for r in 0..rows {
             plan.span_start.push(plan.spans.len() as u32);
             plan.gen_start.push(plan.gens.len() as u32);
+            plan.wrap_start.push(plan.wraps.len() as u32);
+            plan.run_start.push(plan.runs.len() as u32);
             let (y, z) = (r % ny, r / ny);
             let mut run: Option<u32> = None;
+            let mut fluid_run: Option<u32> = None;
             for x in 0..nx {
                 let idx = dom.index(x, y, z);
                 let fluid = dom.kind[idx] == FLUID;
+                // every upstream neighbour a fluid node (through periodic faces)
+                let mut inner = fluid;
                 let mut clean = fluid && x >= 1 && x + 1 < nx;
                 if fluid {
                     plan.fluid_nodes += 1;
@@ -89,8 +104,8 @@ impl Plan {
                         // pull source x - c_i
                         let up = neighbour(dom, [x, y, z], [-c[0], -c[1], -c[2]]);
                         match up {
-                            Upstream::Node(s) => clean &= dom.kind[s] == FLUID,
-                            Upstream::Face(_) => clean = false,
+                            Upstream::Node(s) => inner &= dom.kind[s] == FLUID,
+                            Upstream::Face(_) => inner = false,
                         }
                         // link x -> x + c_i into a wall, for the momentum exchange
                         let target = match neighbour(dom, [x, y, z], c) {
@@ -111,6 +126,15 @@ impl Plan {
                         }
                     }
                 }
+                clean &= inner;
+                match (fluid, fluid_run) {
+                    (true, None) => fluid_run = Some(x as u32),
+                    (false, Some(x0)) => {
+                        plan.runs.push((x0, x as u32));
+                        fluid_run = None;
+                    }
+                    _ => {}
+                }
                 match (clean, run) {
                     (true, None) => run = Some(x as u32),
                     (false, Some(x0)) => {
@@ -119,16 +143,23 @@ impl Plan {
                     }
                     _ => {}
                 }
-                if fluid && !clean {
+                if inner && !clean {
+                    plan.wraps.push(x as u32);
+                } else if fluid && !clean {
                     plan.gens.push(x as u32);
                 }
             }
             if let Some(x0) = run {
                 plan.spans.push((x0, nx as u32));
             }
+            if let Some(x0) = fluid_run {
+                plan.runs.push((x0, nx as u32));
+            }
         }
         plan.span_start.push(plan.spans.len() as u32);
         plan.gen_start.push(plan.gens.len() as u32);
+        plan.wrap_start.push(plan.wraps.len() as u32);
+        plan.run_start.push(plan.runs.len() as u32);
         plan
     }
 }

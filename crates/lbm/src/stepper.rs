@@ -212,7 +212,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             dst: SyncPtr(self.other.as_mut_ptr()),
             params: self.params,
             motions: &self.motions,
-            limits: self.settings.limits,
+            limits: self.settings.limits.in_precision::<T>(),
             out,
         };
         let forced = self.settings.force.iter().any(|&x| x != 0.0);

@@ -10,6 +10,7 @@ use crate::domain::{Face, Motion};
 use crate::kernel::{MacroOut, SyncPtr};
 use crate::kernel_aa::{self, Bad, CtxAa};
 use crate::lattice::Lattice;
+use crate::layout::Layout;
 use crate::plan::Plan;
 use crate::real::Real;
 use crate::stepper::{Fluid, ForceTorque, Macro, Settings, likely_cause};
@@ -22,6 +23,8 @@ pub struct StepperAa<L: Lattice, T: Real> {
     settings: Settings,
     params: CollideParams<T>,
     plan: Plan,
+    /// Layout of `fluid.f` between `new` and `finish` (padded, see `layout`).
+    layout: Layout,
     bad: Vec<Bad>,
     motions: Vec<Motion>,
     /// True when the array is in the reversed layout (next step is odd).
@@ -53,6 +56,8 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         }
         let n = fluid.nodes();
         swap_pairs::<L, T>(&mut fluid.f, n);
+        let mut layout = Layout::padded::<T>(fluid.domain.n);
+        fluid.f = layout.pack(&fluid.f, L::Q);
         let dom = &fluid.domain;
         let mut motions = fluid.obstacles.clone();
         for fc in dom.faces {
@@ -69,6 +74,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             settings,
             params: CollideParams::new(&settings.collision, settings.force)?,
             plan: Plan::build::<L>(dom, fluid.obstacles.len()),
+            layout,
             bad: vec![None; dom.n[1] * dom.n[2]],
             motions,
             reversed: true,
@@ -85,6 +91,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             ));
         }
         let n = fluid.nodes();
+        fluid.f = self.layout.unpack(&fluid.f, L::Q, n);
         swap_pairs::<L, T>(&mut fluid.f, n);
         Ok(())
     }
@@ -109,10 +116,12 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         let ctx = CtxAa {
             dom: &fluid.domain,
             plan: &self.plan,
-            f: SyncPtr(fluid.f.as_mut_ptr()),
+            // slot 0 of the layout (the kernel's offsets do not include `base`)
+            f: SyncPtr(fluid.f[self.layout.base..].as_mut_ptr()),
+            layout: self.layout,
             params: self.params,
             motions: &self.motions,
-            limits: self.settings.limits,
+            limits: self.settings.limits.in_precision::<T>(),
             out,
         };
         let odd = self.reversed;
@@ -153,7 +162,6 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
     /// reversed layout it sits in slot opp(i) of the fluid node; in the natural layout slot opp(i)
     /// holds it already bounced, so the wall term is taken off again.
     fn exchange_forces(&mut self, fluid: &Fluid<L, T>) {
-        let n = fluid.nodes();
         let dom = &fluid.domain;
         let n_obst = fluid.obstacles.len();
         self.forces.iter_mut().for_each(|f| *f = ForceTorque::default());
@@ -175,7 +183,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
                 (self.motions[t].velocity, [0.0; 3])
             };
             let cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1] + c[2] as f64 * uw[2];
-            let stored = fluid.f[o * n + l.node as usize].to_f64();
+            let stored = fluid.f[self.layout.base + self.layout.slot(o, l.node as usize)].to_f64();
             let post = if self.reversed {
                 stored
             } else {
