@@ -10,7 +10,7 @@
 
 use crate::error::CouplingError;
 use crate::psm::{GrainMotion, Load};
-use crate::solid_fraction::GrainCircle;
+use crate::solid_fraction::{GrainCircle, wrap};
 use lbdem_lbm::collision::equilibrium;
 use lbdem_lbm::domain::{FLUID, NO_OBSTACLE, SOLID};
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Lattice, Limits, Macro, Motion, Real, Settings, Stepper};
@@ -165,13 +165,5 @@ impl<T: Real> BounceFluid<T> {
             torque: ft.torque[2],
         }));
         Ok(())
-    }
-}
-
-fn wrap(i: i64, n: usize, periodic: bool) -> Option<usize> {
-    if periodic {
-        Some(i.rem_euclid(n as i64) as usize)
-    } else {
-        (0..n as i64).contains(&i).then_some(i as usize)
     }
 }

@@ -15,7 +15,6 @@
 use crate::error::CouplingError;
 use crate::solid_fraction::SolidMap;
 use crate::weighting::psm_weight;
-use lbdem_lbm::lattice::CS2;
 use lbdem_lbm::plan::{Upstream, neighbour};
 use lbdem_lbm::{D2Q9, Domain, Face, Lattice, Limits, Real};
 use rayon::prelude::*;
@@ -159,10 +158,6 @@ impl<T: Real> PsmFluid<T> {
             cover_load: Vec::new(),
             step: 0,
         })
-    }
-
-    pub fn settings(&self) -> &PsmSettings {
-        &self.settings
     }
 
     /// Set every node to the equilibrium of density `rho` and velocity `u(x, y)`.
@@ -379,16 +374,6 @@ impl<T: Real> PsmFluid<T> {
             t.torque += l.torque;
         }
         Ok(())
-    }
-
-    /// Pressure change Δp = (ρ − ρ₀) c_s² of every node in lattice units (Su Eq. 19), NaN on
-    /// inactive nodes.
-    pub fn pressure_change(&self, rho0: f64) -> Vec<f64> {
-        self.rho
-            .iter()
-            .zip(&self.active)
-            .map(|(&r, &a)| if a { (r - rho0) * CS2 } else { f64::NAN })
-            .collect()
     }
 
     /// Whether node `idx` is updated (not in the inactive zone).

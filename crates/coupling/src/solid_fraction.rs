@@ -58,7 +58,8 @@ fn union_fraction(circles: &[GrainCircle], i: i64, j: i64) -> f64 {
     inside as f64 / (n * n) as f64
 }
 
-fn wrap(i: i64, n: usize, periodic: bool) -> Option<usize> {
+/// Cell index `i` on an axis of `n` cells: wrapped if periodic, `None` outside otherwise.
+pub(crate) fn wrap(i: i64, n: usize, periodic: bool) -> Option<usize> {
     if periodic {
         Some(i.rem_euclid(n as i64) as usize)
     } else {

@@ -7,6 +7,8 @@ use lbdem_coupling::Method;
 use lbdem_dem::{Law, StepParams};
 use serde::Deserialize;
 
+/// The dry-scene tables are repeated here rather than `#[serde(flatten)]`ed from `DryScene`:
+/// serde cannot combine `flatten` with `deny_unknown_fields`, and a misspelt key must be refused.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CoupledScene {
