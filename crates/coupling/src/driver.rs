@@ -44,7 +44,12 @@ pub struct Coupled<T: Real> {
     pub user_torque: Vec<f64>,
     /// Load of the last LBM cycle on each body (SI: N and N m over the depth).
     pub hydro: Vec<Load>,
+    /// Give back to each grain the inertia of the liquid the PSM collision carries inside it
+    /// (see [`Coupled::step`]). Off by default; needs grains denser than the liquid.
+    pub interior_liquid_correction: bool,
     pub timing: Timing,
+    /// Grain motions (lattice units) at the start of the previous LBM cycle.
+    previous: Vec<GrainMotion>,
     dem: Stepper,
     motions: Vec<GrainMotion>,
     circles: Vec<GrainCircle>,
@@ -95,6 +100,8 @@ impl<T: Real> Coupled<T> {
             user_force: sys.bodies.ext_force.clone(),
             user_torque: sys.bodies.ext_torque.clone(),
             hydro: vec![Load::default(); n],
+            interior_liquid_correction: false,
+            previous: Vec::new(),
             sys,
             timing: Timing::default(),
             dem: Stepper::new(),
@@ -134,6 +141,26 @@ impl<T: Real> Coupled<T> {
         self.fluid.map(&self.circles, &self.motions, self.r_hd, periodic)
     }
 
+    /// Switch on the interior-liquid correction; refused where it cannot be stable.
+    ///
+    /// Inside a grain the PSM collision (Eqs. 9, 11) sets the liquid to the grain's velocity
+    /// every step, and Eq. 14 charges the grain for that momentum: a grain accelerates as if it
+    /// weighed (ρ_s + ρ_f) V instead of ρ_s V (its buoyant weight is already applied through the
+    /// DEM's reduced gravity). The correction adds back ρ_f V Δv and ρ_f J Δω per LBM cycle, V and
+    /// J from the same cell fractions (Uhlmann, J. Comput. Phys. 209 (2005) 448, Eq. 15, the
+    /// rigid-body approximation of the interior liquid). It is explicit: its weight ρ_f/ρ_s must
+    /// stay below one, which Uhlmann found to hold in practice down to ρ_s/ρ_f ≈ 1.2.
+    pub fn with_interior_liquid_correction(mut self, rho_ratio: f64) -> Result<Self, CouplingError> {
+        if rho_ratio.is_nan() || rho_ratio < 1.2 {
+            return Err(CouplingError::Unsupported(format!(
+                "interior-liquid correction with grain/liquid density ratio {rho_ratio}: it is explicit and \
+                 unstable below about 1.2 (Uhlmann 2005); switch it off for near-neutral grains"
+            )));
+        }
+        self.interior_liquid_correction = true;
+        Ok(self)
+    }
+
     /// One LBM cycle and `ratio` DEM cycles.
     pub fn step(&mut self) -> Result<(), CouplingError> {
         let t0 = Instant::now();
@@ -141,6 +168,9 @@ impl<T: Real> Coupled<T> {
         let t1 = Instant::now();
         self.fluid.step(&self.motions, &mut self.loads)?;
         let t2 = Instant::now();
+        if self.interior_liquid_correction {
+            self.add_interior_liquid();
+        }
         let b = &mut self.sys.bodies;
         for k in 0..b.len() {
             let l = &self.loads[k];
@@ -165,6 +195,24 @@ impl<T: Real> Coupled<T> {
         self.timing.lbm += t2 - t1;
         self.timing.dem += t4 - t3;
         Ok(())
+    }
+
+    /// Cancel the interior liquid's share of the last load: in this LBM cycle the collision
+    /// brought the liquid inside each grain from the grain's previous velocity to its present
+    /// one, ρ_f V Δv of momentum (ρ_f = 1 in lattice units) that Eq. 14 took from the grain.
+    fn add_interior_liquid(&mut self) {
+        if let Some(inner) = self.fluid.interior_liquid(&self.motions)
+            && self.previous.len() == self.motions.len()
+        {
+            for (k, (area, polar)) in inner.into_iter().enumerate() {
+                let (now, before) = (&self.motions[k], &self.previous[k]);
+                let l = &mut self.loads[k];
+                l.force[0] += area * (now.velocity[0] - before.velocity[0]);
+                l.force[1] += area * (now.velocity[1] - before.velocity[1]);
+                l.torque += polar * (now.omega - before.omega);
+            }
+        }
+        self.previous.clone_from(&self.motions);
     }
 
     /// Total momentum of fluid and grains (SI, over the sample's depth).

@@ -71,6 +71,26 @@ impl<T: Real> Hydro<T> {
         }
     }
 
+    /// Per grain, the liquid the PSM collision drags along inside it: Σ ε_s (its area in
+    /// cells, with r_hd) and Σ ε_s |r|² (its polar moment about the grain centre). `None` for
+    /// bounce-back, whose covered nodes hold no liquid.
+    pub fn interior_liquid(&self, motions: &[GrainMotion]) -> Option<Vec<(f64, f64)>> {
+        let Hydro::Psm { fluid, map } = self else {
+            return None;
+        };
+        let (nx, ny) = (fluid.nx, fluid.ny);
+        let mut out = vec![(0.0, 0.0); motions.len()];
+        for cv in &map.covers {
+            let idx = cv.cell as usize;
+            let x = [(idx % nx) as f64 + 0.5, (idx / nx) as f64 + 0.5];
+            let r = crate::psm::min_image(x, motions[cv.body as usize].centre, nx, ny);
+            let o = &mut out[cv.body as usize];
+            o.0 += cv.fraction;
+            o.1 += cv.fraction * (r[0] * r[0] + r[1] * r[1]);
+        }
+        Some(out)
+    }
+
     /// One LBM step; the load on each grain in lattice units.
     pub fn step(&mut self, motions: &[GrainMotion], loads: &mut Vec<Load>) -> Result<(), CouplingError> {
         match self {

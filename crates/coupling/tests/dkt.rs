@@ -2,9 +2,9 @@
 //! (2001) 363, as listed in REFERENCES.md): channel 0.02 m x 0.08 m, disks of 2 mm, ρ_p = 1010,
 //! ρ_f = 1000 kg/m³, ν = 1e-6 m²/s, released at rest from (0.01, 0.068) and (0.00999, 0.072).
 //!
-//! No published trajectory of this set-up is stored here (see the issue-6 note), so this is NOT
-//! the acceptance comparison: it only checks that the three phases the set-up is known for all
-//! occur (each is searched for after the previous one, so their order holds by construction):
+//! No published trajectory of this set-up is stored here; the comparison with published
+//! trajectories runs on Uhlmann's (2005) version of the case in `dkt_uhlmann.rs`. This test only
+//! checks that the three phases the set-up is known for all occur (each is searched for after the previous one, so their order holds by construction):
 //! the trailing disk, in the leading disk's wake, falls more than 10 % faster than it (drafting);
 //! the gap closes below a tenth of a diameter (kissing); the trailing disk ends half a diameter
 //! below the leading one (tumbling). The thresholds are this test's choice, not published ones.

@@ -1,0 +1,248 @@
+//! Drafting, kissing and tumbling of two disks against published trajectories: Uhlmann (J. Comput.
+//! Phys. 209 (2005) 448, Figs. 6a and 7a) and Koblitz et al. (J. Comput. Phys. 343 (2017) 414,
+//! Figs. 10a and 10c) of the same case (set-up in `lbdem_coupling::cases::dkt`), digitised in
+//! `tests/data/` (see the READMEs there).
+//!
+//! After the kiss the motion is unstable, and the two publications part: the test measures
+//! agreement against their difference, computed from the stored curves, instead of a fixed
+//! tolerance. Through the first tumble (the pair's line of centres turning past 45° from the
+//! vertical), the run must:
+//! - follow Uhlmann's depths up to the kiss (t ≤ 0.18 s) to within 0.1 d RMS (the published
+//!   curves agree that well there);
+//! - tumble within the two publications' tumble times, widened on each side by their difference.
+//!
+//! It also prints, without asserting it (the one part of the comparison not met yet), how far the
+//! depths stray, up to the later of the two tumble times, outside the envelope of the two
+//! publications' depths: the aim is a quarter of a diameter (this test's choice, not a published
+//! figure).
+//!
+//! CI: 16 cells per diameter (about 10 s in release). `cargo test --release -p lbdem-coupling
+//! --test dkt_uhlmann -- --ignored --nocapture` runs 24 cells per diameter and the variants
+//! without the interior-liquid correction and with BGK, to show what each choice does.
+
+use lbdem_coupling::cases::dkt::{DktResult, DktSpec, interpolate, run};
+
+const D: f64 = 2.5e-3;
+/// t_ref = d / √(π d (ρ_p/ρ_f − 1) g / 2) of Koblitz et al. (s).
+fn t_ref() -> f64 {
+    D / (std::f64::consts::PI * D * 0.5 * 9.81 / 2.0).sqrt()
+}
+const T_KISS: f64 = 0.18;
+
+/// Two columns of numbers, each mapped.
+fn series(text: &str, ft: impl Fn(f64) -> f64, fx: impl Fn(f64) -> f64) -> (Vec<f64>, Vec<f64>) {
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let mut it = l.split_whitespace().map(|v| v.parse::<f64>().expect("number"));
+            (ft(it.next().expect("t")), fx(it.next().expect("x")))
+        })
+        .unzip()
+}
+
+/// Depth and lateral position of the trailing (0) and leading (1) disk over time (SI).
+struct Trajectory {
+    depth: [(Vec<f64>, Vec<f64>); 2],
+    lateral: [(Vec<f64>, Vec<f64>); 2],
+}
+
+impl Trajectory {
+    fn uhlmann() -> Self {
+        let cm = |x: f64| x * 1e-2;
+        let id = |t: f64| t;
+        Self {
+            depth: [
+                series(include_str!("data/uhlmann2005/fig6a-trailing.txt"), id, cm),
+                series(include_str!("data/uhlmann2005/fig6a-leading.txt"), id, cm),
+            ],
+            lateral: [
+                series(include_str!("data/uhlmann2005/fig7a-trailing.txt"), id, cm),
+                series(include_str!("data/uhlmann2005/fig7a-leading.txt"), id, cm),
+            ],
+        }
+    }
+    fn koblitz() -> Self {
+        let t = |s: f64| s * t_ref();
+        let depth = |x: f64| -x * D;
+        let lateral = |x: f64| (x - 4.0) * D;
+        Self {
+            depth: [
+                series(include_str!("data/koblitz2017/fig10c-trailing.txt"), t, depth),
+                series(include_str!("data/koblitz2017/fig10c-leading.txt"), t, depth),
+            ],
+            lateral: [
+                series(include_str!("data/koblitz2017/fig10a-trailing.txt"), t, lateral),
+                series(include_str!("data/koblitz2017/fig10a-leading.txt"), t, lateral),
+            ],
+        }
+    }
+    fn simulated(r: &DktResult) -> Self {
+        let ts: Vec<f64> = r.samples.iter().map(|s| s.t).collect();
+        let col = |f: &dyn Fn(usize, &lbdem_coupling::cases::dkt::DktSample) -> f64, k| {
+            (ts.clone(), r.samples.iter().map(|s| f(k, s)).collect::<Vec<_>>())
+        };
+        let depth = |k: usize, s: &lbdem_coupling::cases::dkt::DktSample| s.depth[k];
+        let lateral = |k: usize, s: &lbdem_coupling::cases::dkt::DktSample| s.lateral[k];
+        Self {
+            depth: [col(&depth, 0), col(&depth, 1)],
+            lateral: [col(&lateral, 0), col(&lateral, 1)],
+        }
+    }
+    fn depth_at(&self, k: usize, t: f64) -> f64 {
+        interpolate(&self.depth[k].0, &self.depth[k].1, t)
+    }
+    fn lateral_at(&self, k: usize, t: f64) -> f64 {
+        interpolate(&self.lateral[k].0, &self.lateral[k].1, t)
+    }
+    /// First time after the kiss at which the line of centres is more horizontal than vertical.
+    fn tumble_time(&self) -> Option<f64> {
+        (0..=300).map(|i| T_KISS + 0.0004 * i as f64).find(|&t| {
+            let dz = self.depth_at(1, t) - self.depth_at(0, t);
+            let dl = self.lateral_at(1, t) - self.lateral_at(0, t);
+            dl.abs() > dz.abs()
+        })
+    }
+    /// Largest depth difference (in d) to `other` of either disk at `other`'s sample times in (t0, t1].
+    fn max_depth_difference(&self, other: &Self, t0: f64, t1: f64) -> f64 {
+        let mut m = 0.0f64;
+        for k in 0..2 {
+            for (&t, &x) in other.depth[k].0.iter().zip(&other.depth[k].1) {
+                if t > t0 && t <= t1 {
+                    m = m.max((self.depth_at(k, t) - x).abs() / D);
+                }
+            }
+        }
+        m
+    }
+    /// Largest distance (in d) of either disk's depth outside the envelope of `a` and `b`, at
+    /// every millisecond in (0, t1].
+    fn max_outside(&self, a: &Self, b: &Self, t1: f64) -> f64 {
+        let mut m = 0.0f64;
+        for k in 0..2 {
+            for i in 1..=(t1 * 1e3) as usize {
+                let t = i as f64 * 1e-3;
+                let (x, y) = (a.depth_at(k, t), b.depth_at(k, t));
+                let ours = self.depth_at(k, t);
+                m = m.max((x.min(y) - ours).max(ours - x.max(y)).max(0.0) / D);
+            }
+        }
+        m
+    }
+    /// RMS depth difference (in d) to `other` at `other`'s sample times up to `t1`.
+    fn rms_depth_difference(&self, other: &Self, t1: f64) -> f64 {
+        let (mut sq, mut n) = (0.0, 0usize);
+        for k in 0..2 {
+            for (&t, &x) in other.depth[k].0.iter().zip(&other.depth[k].1) {
+                if t <= t1 {
+                    sq += ((self.depth_at(k, t) - x) / D).powi(2);
+                    n += 1;
+                }
+            }
+        }
+        (sq / n as f64).sqrt()
+    }
+}
+
+struct Verdict {
+    rms_drafting: f64,
+    tumble: f64,
+    tumble_band: (f64, f64),
+    outside: f64,
+}
+
+/// How far outside the published envelope a run should stray at most (in d; this test's choice).
+/// Printed, not yet asserted.
+const MARGIN: f64 = 0.25;
+
+fn judge(label: &str, spec: &DktSpec) -> Verdict {
+    let r = run::<f64>(spec).expect("stable run");
+    let ours = Trajectory::simulated(&r);
+    let (u, k) = (Trajectory::uhlmann(), Trajectory::koblitz());
+    let (tu, tk) = (
+        u.tumble_time().expect("Uhlmann's pair tumbles"),
+        k.tumble_time().expect("Koblitz's pair tumbles"),
+    );
+    let spread = (tu - tk).abs();
+    let band = (tu.min(tk) - spread, tu.max(tk) + spread);
+    let t_end = tu.max(tk);
+    let koblitz_vs_uhlmann = k.max_depth_difference(&u, 0.0, t_end);
+    let v = Verdict {
+        rms_drafting: ours.rms_depth_difference(&u, T_KISS),
+        tumble: ours.tumble_time().unwrap_or(f64::INFINITY),
+        tumble_band: band,
+        outside: ours.max_outside(&u, &k, t_end),
+    };
+    eprintln!(
+        "DKT {label}: {} cells/d, tau {:.4}, TRT {:?}, interior-liquid correction {}, contact range {} cells:\n  \
+         depth RMS vs Uhlmann to the kiss ({T_KISS} s) {:.3} d (limit 0.1)\n  \
+         tumble (45°) at {:.4} s; Uhlmann {tu:.4} s, Koblitz et al. {tk:.4} s, band [{:.4}, {:.4}]\n  \
+         up to {t_end:.4} s: largest depth difference to Uhlmann {:.3} d (Koblitz et al.'s: {koblitz_vs_uhlmann:.3} d), \
+         largest distance outside the two publications' envelope {:.3} d (aim {MARGIN}, not asserted)\n  \
+         smallest gap {:.3} d; {} steps of {} nodes in {:.1} s",
+        spec.cells_per_diameter,
+        spec.tau,
+        spec.trt_magic,
+        spec.interior_liquid_correction,
+        spec.contact_range_cells,
+        v.rms_drafting,
+        v.tumble,
+        band.0,
+        band.1,
+        ours.max_depth_difference(&u, 0.0, t_end),
+        v.outside,
+        r.min_gap / D,
+        r.lbm_steps,
+        r.nodes,
+        r.wall_seconds,
+    );
+    v
+}
+
+fn spec(cells: usize) -> DktSpec {
+    let mut s = DktSpec {
+        cells_per_diameter: cells,
+        ..DktSpec::default()
+    };
+    s.tau = s.tau_for(0.15);
+    s
+}
+
+fn assert_follows(v: &Verdict) {
+    assert!(v.rms_drafting < 0.1, "drafting: RMS {:.3} d", v.rms_drafting);
+    assert!(
+        v.tumble >= v.tumble_band.0 && v.tumble <= v.tumble_band.1,
+        "tumble at {} s outside {:?}",
+        v.tumble,
+        v.tumble_band
+    );
+    // Not asserted: v.outside <= MARGIN. During the kiss (0.18-0.25 s) the simulated pair falls
+    // behind both publications by 0.36 d (16 cells) and 0.47 d (24 cells) beyond their envelope,
+    // whatever the contact range (1-4 cells); the cause is not found yet (see docs/coupling.md).
+    let _ = v.outside;
+}
+
+#[test]
+fn two_disks_follow_the_published_trajectories_through_the_first_tumble() {
+    assert_follows(&judge("CI", &spec(16)));
+}
+
+#[test]
+#[ignore]
+fn finer_lattice_and_the_variants() {
+    assert_follows(&judge("finer", &spec(24)));
+    // Without the interior-liquid correction the disks fall as if they weighed ρ_p + ρ_f.
+    let mut s = spec(16);
+    s.interior_liquid_correction = false;
+    let v = judge("no interior-liquid correction", &s);
+    assert!(
+        v.rms_drafting > 0.1,
+        "the correction should matter: RMS {:.3} d",
+        v.rms_drafting
+    );
+    let mut s = spec(16);
+    s.trt_magic = None;
+    judge("BGK", &s);
+    let mut s = spec(16);
+    s.contact_range_cells = 0.0;
+    judge("contact at the surfaces", &s);
+}
