@@ -97,6 +97,9 @@ pub struct DktSample {
     pub t: f64,
     pub depth: [f64; 2],
     pub lateral: [f64; 2],
+    /// Velocity along gravity (downward positive) and lateral velocity (m/s).
+    pub fall_speed: [f64; 2],
+    pub lateral_speed: [f64; 2],
 }
 
 #[derive(Clone, Debug)]
@@ -181,11 +184,13 @@ pub fn run<T: Real>(spec: &DktSpec) -> Result<DktResult, CouplingError> {
     let steps = (spec.duration / dt).ceil() as u64;
     let every = ((spec.sample / dt).round() as u64).max(1);
     let sample = |run: &Coupled<T>, t: f64| {
-        let p = &run.sys.bodies.pos;
+        let (p, v) = (&run.sys.bodies.pos, &run.sys.bodies.vel);
         DktSample {
             t,
             depth: [h - p[0].y, h - p[1].y],
             lateral: [p[0].x - centre, p[1].x - centre],
+            fall_speed: [-v[0].y, -v[1].y],
+            lateral_speed: [v[0].x, v[1].x],
         }
     };
     let mut samples = vec![sample(&run, 0.0)];
