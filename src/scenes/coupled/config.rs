@@ -90,6 +90,14 @@ pub struct CouplingCfg {
     /// Membrane grains (tag 1) do not feel the liquid.
     #[serde(default)]
     pub dry_membrane: bool,
+    /// PSM only: relax the liquid with two rates (TRT) of this magic parameter (1/4 is usual)
+    /// instead of BGK; needed near τ = ½ (Reynolds numbers of hundreds).
+    #[serde(default)]
+    pub trt_magic: Option<f64>,
+    /// PSM only: give the grains back the inertia of the liquid PSM carries inside them
+    /// (Uhlmann 2005); refused unless every grain is at least 1.2 times denser than the liquid.
+    #[serde(default)]
+    pub interior_liquid_correction: bool,
 }
 
 impl Default for CouplingCfg {
@@ -99,6 +107,8 @@ impl Default for CouplingCfg {
             r_hd: r_hd(),
             depth: 1.0,
             dry_membrane: false,
+            trt_magic: None,
+            interior_liquid_correction: false,
         }
     }
 }

@@ -167,16 +167,33 @@ fn run_with<T: Real>(cfg: &CoupledScene, ctx: &SimContext) -> Result<StageOutput
     );
     let tau = units.lattice.tau;
     let limits = Limits::default();
+    let psm_only = |what: &str| {
+        anyhow::anyhow!("[coupling] {what} is for method = \"psm\" only; remove it or set method = \"psm\"")
+    };
     let hydro = match cfg.coupling.method {
-        Method::Psm => Hydro::psm(PsmFluid::<T>::new(
-            &domain,
-            PsmSettings {
-                tau,
-                force: [0.0; 2],
-                limits,
-            },
-        )?),
+        Method::Psm => {
+            let mut fluid = PsmFluid::<T>::new(
+                &domain,
+                PsmSettings {
+                    tau,
+                    force: [0.0; 2],
+                    limits,
+                },
+            )?;
+            if let Some(m) = cfg.coupling.trt_magic {
+                fluid = fluid
+                    .with_trt(m)
+                    .map_err(|e| anyhow::anyhow!("[coupling] trt_magic: {e}"))?;
+            }
+            Hydro::psm(fluid)
+        }
         Method::BounceBack => {
+            if cfg.coupling.trt_magic.is_some() {
+                return Err(psm_only("trt_magic"));
+            }
+            if cfg.coupling.interior_liquid_correction {
+                return Err(psm_only("interior_liquid_correction"));
+            }
             Hydro::BounceBack(Box::new(BounceFluid::<T>::new(domain, tau, [0.0; 2], limits)?))
         }
     };
@@ -185,6 +202,20 @@ fn run_with<T: Real>(cfg: &CoupledScene, ctx: &SimContext) -> Result<StageOutput
     let mut run = Coupled::new(hydro, sys, law, wall_law, cfg.step, units, cfg.coupling.r_hd)
         .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;
     run.depth = cfg.coupling.depth;
+    if cfg.coupling.interior_liquid_correction {
+        // Particle densities are per sample depth (kg/m²).
+        let lightest = run
+            .sys
+            .bodies
+            .density
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let ratio = lightest / cfg.coupling.depth / cfg.fluid.density;
+        run = run
+            .with_interior_liquid_correction(ratio)
+            .map_err(|e| anyhow::anyhow!("[coupling] interior_liquid_correction = true: {e}"))?;
+    }
     if cfg.coupling.dry_membrane {
         for k in 0..run.sys.bodies.len() {
             run.dry[k] = run.sys.bodies.tag[k] == 1;

@@ -138,3 +138,40 @@ fn zero_output_interval_and_moving_walls_are_refused() {
     assert!(e.contains("moving walls"), "{e}");
     assert!(!out_dir.exists());
 }
+
+#[test]
+fn trt_runs_and_the_interior_correction_is_refused_for_floating_grains() {
+    let dir = tempfile::tempdir().unwrap();
+    let trt = example(|t| short(t).replace("depth = 1.0e-3", "depth = 1.0e-3\ntrt_magic = 0.25"));
+    let out = run(&trt, &ctx(dir.path())).unwrap();
+    assert!(out.summary["last"]["hydro_force"][1].as_f64().unwrap() < 0.0);
+
+    // The example's grains are lighter than the liquid (2550 vs 2856 kg/m³): the explicit
+    // correction would be unstable, so it is refused, naming the parameter and the ratio.
+    let dir = tempfile::tempdir().unwrap();
+    let corr = example(|t| {
+        short(t).replace(
+            "depth = 1.0e-3",
+            "depth = 1.0e-3\ninterior_liquid_correction = true",
+        )
+    });
+    let e = format!("{:#}", run(&corr, &ctx(dir.path())).unwrap_err());
+    assert!(
+        e.contains("interior_liquid_correction") && e.contains("0.89"),
+        "{e}"
+    );
+    assert!(
+        walk(dir.path()).is_empty(),
+        "nothing may be written: {:?}",
+        walk(dir.path())
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let bb = example(|t| {
+        short(t)
+            .replace("method = \"psm\"", "method = \"bounce-back\"")
+            .replace("depth = 1.0e-3", "depth = 1.0e-3\ntrt_magic = 0.25")
+    });
+    let e = format!("{:#}", run(&bb, &ctx(dir.path())).unwrap_err());
+    assert!(e.contains("trt_magic") && e.contains("psm"), "{e}");
+}
