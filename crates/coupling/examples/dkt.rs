@@ -1,6 +1,7 @@
 //! The drafting-kissing-tumbling case of Uhlmann (2005) as CSV on stdout, for plotting against
 //! the digitised curves in `tests/data/`:
-//! `cargo run --release -p lbdem-coupling --example dkt -- [CELLS_PER_DIAMETER] [U_LATTICE]`.
+//! `cargo run --release -p lbdem-coupling --example dkt -- [CELLS_PER_DIAMETER] [U_LATTICE] [CONTACT_RANGE_CELLS]`
+//! (`DKT_NO_CORRECTION=1` switches the interior-liquid correction off).
 
 use lbdem_coupling::cases::dkt::{DktSpec, run};
 
@@ -12,6 +13,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cells_per_diameter: cells,
         ..DktSpec::default()
     };
+    if let Some(z) = args.next() {
+        spec.contact_range_cells = z.parse()?;
+    }
+    if std::env::var("DKT_NO_CORRECTION").is_ok() {
+        spec.interior_liquid_correction = false;
+    }
     spec.tau = spec.tau_for(u);
     let r = run::<f64>(&spec)?;
     println!(
