@@ -17,7 +17,7 @@
 //! figure).
 //!
 //! CI: 16 cells per diameter (about 10 s in release). `cargo test --release -p lbdem-coupling
-//! --test dkt_uhlmann -- --ignored --nocapture` runs 24 cells per diameter and the variants
+//! --test dkt_uhlmann -- --ignored --nocapture` runs 24 and 32 cells per diameter and the variants
 //! without the interior-liquid correction and with BGK, to show what each choice does.
 
 use lbdem_coupling::cases::dkt::{DktResult, DktSpec, interpolate, run};
@@ -245,4 +245,14 @@ fn finer_lattice_and_the_variants() {
     let mut s = spec(16);
     s.contact_range_cells = 0.0;
     judge("contact at the surfaces", &s);
+}
+
+/// 32 cells per diameter, at u_lattice 0.08 (at 0.15 the gap flow at the kiss goes unstable):
+/// about 3 minutes in release.
+#[test]
+#[ignore]
+fn finest_lattice() {
+    let mut s = spec(32);
+    s.tau = s.tau_for(0.08);
+    assert_follows(&judge("finest", &s));
 }
