@@ -12,11 +12,9 @@ use crate::driver::Coupled;
 use crate::error::CouplingError;
 use crate::hydro::Hydro;
 use crate::psm::{PsmFluid, PsmSettings};
-use crate::units::CouplingUnits;
-use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
 use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::{Bodies, ClumpShape, Damping, Law, StepParams, System, Vec2, Vector, generate};
-use lbdem_lbm::{Domain, Face, Limits, Real};
+use lbdem_lbm::{Limits, Real};
 use std::time::Instant;
 
 /// The physical set-up (SI) and the numerical choices.
@@ -117,24 +115,16 @@ pub fn run<T: Real>(spec: &DktSpec) -> Result<DktResult, CouplingError> {
     let d = spec.diameter;
     let dx = d / spec.cells_per_diameter as f64;
     let (w, h) = (spec.width, spec.height);
-    let (nx, ny) = ((w / dx).round() as usize, (h / dx).round() as usize);
-    let u_scale = spec.velocity_scale();
-    let lattice = LatticeUnits::derive(&LatticeInput::new(
+    let b = super::closed_box(
+        [w, h],
         dx,
         spec.nu,
         spec.rho_f,
-        u_scale,
-        TimeSpec::Tau(spec.tau),
-    ))
-    .map_err(|e| CouplingError::Unsupported(e.to_string()))?;
-    let dt = lattice.dt;
-    let units = CouplingUnits::new(lattice, [0.0, 0.0], dt / spec.ratio as f64)?;
-
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let domain = Domain::new(
-        [nx, ny, 1],
-        [wall, wall, wall, wall, Face::Periodic, Face::Periodic],
-    );
+        spec.velocity_scale(),
+        spec.tau,
+        spec.ratio,
+    )?;
+    let (dt, units, domain) = (b.dt, b.units, b.domain);
     let mut fluid = PsmFluid::<T>::new(
         &domain,
         PsmSettings {
@@ -207,7 +197,7 @@ pub fn run<T: Real>(spec: &DktSpec) -> Result<DktResult, CouplingError> {
     Ok(DktResult {
         samples,
         lbm_steps: steps,
-        nodes: nx * ny,
+        nodes: b.nodes,
         wall_seconds: start.elapsed().as_secs_f64(),
         min_gap,
     })

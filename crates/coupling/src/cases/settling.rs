@@ -15,12 +15,11 @@ use crate::driver::Coupled;
 use crate::error::CouplingError;
 use crate::hydro::{Hydro, Method};
 use crate::psm::PsmFluid;
-use crate::units::CouplingUnits;
 use crate::{PsmSettings, bounce::BounceFluid};
-use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
+
 use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::{Bodies, ClumpShape, Damping, Law, StepParams, System, Vec2};
-use lbdem_lbm::{Domain, Face, Limits, Real};
+use lbdem_lbm::{Limits, Real};
 use std::time::Instant;
 
 /// F/(μU) of a cylinder midway between two walls, k = d/W (Faxén 1946).
@@ -102,24 +101,9 @@ pub fn run<T: Real>(spec: &SettlingSpec) -> Result<SettlingResult, CouplingError
     let d = spec.diameter;
     let dx = d / spec.cells_per_diameter as f64;
     let (w, h) = (spec.width * d, spec.height * d);
-    let (nx, ny) = ((w / dx).round() as usize, (h / dx).round() as usize);
     let u_ref = spec.reference_velocity();
-    let lattice = LatticeUnits::derive(&LatticeInput::new(
-        dx,
-        spec.nu,
-        spec.rho_f,
-        2.0 * u_ref,
-        TimeSpec::Tau(spec.tau),
-    ))
-    .map_err(|e| CouplingError::Unsupported(e.to_string()))?;
-    let dt = lattice.dt;
-    let units = CouplingUnits::new(lattice, [0.0, 0.0], dt)?;
-
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let domain = Domain::new(
-        [nx, ny, 1],
-        [wall, wall, wall, wall, Face::Periodic, Face::Periodic],
-    );
+    let b = super::closed_box([w, h], dx, spec.nu, spec.rho_f, 2.0 * u_ref, spec.tau, 1)?;
+    let (dt, units, domain) = (b.dt, b.units, b.domain);
     let limits = Limits::default();
     let hydro = match spec.method {
         Method::Psm => Hydro::psm(PsmFluid::<T>::new(
@@ -175,7 +159,7 @@ pub fn run<T: Real>(spec: &SettlingSpec) -> Result<SettlingResult, CouplingError
         reynolds: v * d / spec.nu,
         drift: run.sys.bodies.pos[0].x - x0,
         lbm_steps: steps,
-        nodes: nx * ny,
+        nodes: b.nodes,
         wall_seconds,
     })
 }
