@@ -45,8 +45,8 @@ pub struct Coupled<T: Real> {
     /// Load of the last LBM cycle on each body (SI: N and N m over the depth).
     pub hydro: Vec<Load>,
     /// Give back to each grain the inertia of the liquid the PSM collision carries inside it
-    /// (see [`Coupled::step`]). Off by default; needs grains denser than the liquid.
-    pub interior_liquid_correction: bool,
+    /// (see [`Coupled::with_interior_liquid_correction`]). Off by default.
+    interior_liquid_correction: bool,
     pub timing: Timing,
     /// Grain motions (lattice units) at the start of the previous LBM cycle.
     previous: Vec<GrainMotion>,
@@ -141,20 +141,42 @@ impl<T: Real> Coupled<T> {
         self.fluid.map(&self.circles, &self.motions, self.r_hd, periodic)
     }
 
-    /// Switch on the interior-liquid correction; refused where it cannot be stable.
+    /// Switch on the interior-liquid correction (PSM only; refused where it cannot be stable).
     ///
-    /// Inside a grain the PSM collision (Eqs. 9, 11) sets the liquid to the grain's velocity
-    /// every step, and Eq. 14 charges the grain for that momentum: a grain accelerates as if it
-    /// weighed (ρ_s + ρ_f) V instead of ρ_s V (its buoyant weight is already applied through the
-    /// DEM's reduced gravity). The correction adds back ρ_f V Δv and ρ_f J Δω per LBM cycle, V and
-    /// J from the same cell fractions (Uhlmann, J. Comput. Phys. 209 (2005) 448, Eq. 15, the
-    /// rigid-body approximation of the interior liquid). It is explicit: its weight ρ_f/ρ_s must
-    /// stay below one, which Uhlmann found to hold in practice down to ρ_s/ρ_f ≈ 1.2.
-    pub fn with_interior_liquid_correction(mut self, rho_ratio: f64) -> Result<Self, CouplingError> {
-        if rho_ratio.is_nan() || rho_ratio < 1.2 {
+    /// Inside a grain the PSM collision (Eqs. 9, 11) replaces the share B_s of the liquid's
+    /// momentum by the grain's every step, and Eq. 14 charges the grain for it, so that in the
+    /// end the liquid inside moves with the grain: a grain
+    /// accelerates as if it weighed (ρ_s + ρ_f) V instead of ρ_s V (its buoyant weight is already
+    /// applied through the DEM's reduced gravity). The correction gives back, per LBM cycle, the
+    /// momentum and angular momentum that moving that liquid rigidly from the grain's previous
+    /// motion to its present one takes (Uhlmann, J. Comput. Phys. 209 (2005) 448, Eq. 15, the
+    /// rigid-body approximation of the interior liquid), with the weights of
+    /// [`Hydro::interior_liquid`]. It is explicit; Uhlmann reports it stable for density ratios
+    /// down to about 1.2, a limit adopted here without a test of its own, so the lightest grain
+    /// that feels the liquid must be at least 1.2 times denser than it.
+    ///
+    /// With it on, [`Coupled::momentum`] (all the liquid plus the grains) is no longer conserved:
+    /// the liquid inside the grains is counted twice.
+    pub fn with_interior_liquid_correction(mut self) -> Result<Self, CouplingError> {
+        if self.fluid.method() != crate::hydro::Method::Psm {
+            return Err(CouplingError::Unsupported(
+                "the interior-liquid correction is for PSM; bounce-back grains hold no liquid: \
+                 switch it off or use method = \"psm\""
+                    .into(),
+            ));
+        }
+        let b = &self.sys.bodies;
+        let rho_f = self.units.lattice.rho;
+        let lightest = (0..b.len())
+            .filter(|&k| !self.dry[k])
+            .map(|k| b.density[k] / self.depth)
+            .fold(f64::INFINITY, f64::min);
+        let ratio = lightest / rho_f;
+        if ratio.is_nan() || ratio < 1.2 {
             return Err(CouplingError::Unsupported(format!(
-                "interior-liquid correction with grain/liquid density ratio {rho_ratio}: it is explicit and \
-                 unstable below about 1.2 (Uhlmann 2005); switch it off for near-neutral grains"
+                "interior-liquid correction with grain/liquid density ratio {ratio:.3} (lightest wet grain \
+                 {lightest} kg/m³, liquid {rho_f} kg/m³): it is explicit and unstable below about 1.2 \
+                 (Uhlmann 2005); switch it off for near-neutral grains"
             )));
         }
         self.interior_liquid_correction = true;
@@ -198,24 +220,33 @@ impl<T: Real> Coupled<T> {
     }
 
     /// Cancel the interior liquid's share of the last load: in this LBM cycle the collision
-    /// brought the liquid inside each grain from the grain's previous velocity to its present
-    /// one, ρ_f V Δv of momentum (ρ_f = 1 in lattice units) that Eq. 14 took from the grain.
+    /// moved the liquid it carries with each grain from the grain's previous motion to its
+    /// present one (before the first cycle the liquid is at rest). For the rigid field
+    /// v + ω ẑ × r the momentum is A v + ω ẑ × S and the angular momentum S × v + J ω.
     fn add_interior_liquid(&mut self) {
-        if let Some(inner) = self.fluid.interior_liquid(&self.motions)
-            && self.previous.len() == self.motions.len()
-        {
-            for (k, (area, polar)) in inner.into_iter().enumerate() {
-                let (now, before) = (&self.motions[k], &self.previous[k]);
-                let l = &mut self.loads[k];
-                l.force[0] += area * (now.velocity[0] - before.velocity[0]);
-                l.force[1] += area * (now.velocity[1] - before.velocity[1]);
-                l.torque += polar * (now.omega - before.omega);
-            }
+        let Some(inner) = self.fluid.interior_liquid(&self.motions) else {
+            return;
+        };
+        if self.previous.len() != self.motions.len() {
+            self.previous = vec![GrainMotion::default(); self.motions.len()];
+        }
+        for (k, m) in inner.into_iter().enumerate() {
+            let (now, before) = (&self.motions[k], &self.previous[k]);
+            let dv = [
+                now.velocity[0] - before.velocity[0],
+                now.velocity[1] - before.velocity[1],
+            ];
+            let dw = now.omega - before.omega;
+            let l = &mut self.loads[k];
+            l.force[0] += m.area * dv[0] - dw * m.first[1];
+            l.force[1] += m.area * dv[1] + dw * m.first[0];
+            l.torque += m.first[0] * dv[1] - m.first[1] * dv[0] + m.polar * dw;
         }
         self.previous.clone_from(&self.motions);
     }
 
-    /// Total momentum of fluid and grains (SI, over the sample's depth).
+    /// Total momentum of fluid and grains (SI, over the sample's depth); conserved to round-off
+    /// unless the interior-liquid correction is on.
     pub fn momentum(&self) -> [f64; 2] {
         let (_, j) = self.fluid.mass_momentum();
         let mut p = self.units.momentum_to_si(j).map(|x| x * self.depth);

@@ -21,6 +21,15 @@ pub enum Method {
     BounceBack,
 }
 
+/// Moments of the liquid a grain carries (lattice units, ρ = 1): mass A = Σ w, first moment
+/// S = Σ w r and polar moment J = Σ w |r|² about the grain centre.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InteriorLiquid {
+    pub area: f64,
+    pub first: [f64; 2],
+    pub polar: f64,
+}
+
 /// One per run: the size difference between the variants does not matter.
 #[allow(clippy::large_enum_variant)]
 pub enum Hydro<T: Real> {
@@ -71,22 +80,32 @@ impl<T: Real> Hydro<T> {
         }
     }
 
-    /// Per grain, the liquid the PSM collision drags along inside it: Σ ε_s (its area in
-    /// cells, with r_hd) and Σ ε_s |r|² (its polar moment about the grain centre). `None` for
+    /// Per grain, the liquid the PSM collision drags along with it: the sum over its cells of
+    /// the weight w, of w r and of w |r|² (r from the grain centre, lattice units). `None` for
     /// bounce-back, whose covered nodes hold no liquid.
-    pub fn interior_liquid(&self, motions: &[GrainMotion]) -> Option<Vec<(f64, f64)>> {
+    ///
+    /// The weight is the covered fraction ε_s. In one step the collision replaces only the share
+    /// B_s of Eq. 10 of a cell's liquid momentum, and near τ = ½ B_s is far below ε_s in partly
+    /// covered cells; but it does so every step, so over the many steps in which a grain changes
+    /// speed the liquid of a partly covered cell follows the grain as well. On the DKT case
+    /// (`tests/dkt_uhlmann.rs`, 16 cells per diameter, τ = 0.51) the ε_s weight gives a drafting
+    /// error of 0.04 d RMS, the B_s weight 0.14 d.
+    pub fn interior_liquid(&self, motions: &[GrainMotion]) -> Option<Vec<InteriorLiquid>> {
         let Hydro::Psm { fluid, map } = self else {
             return None;
         };
         let (nx, ny) = (fluid.nx, fluid.ny);
-        let mut out = vec![(0.0, 0.0); motions.len()];
+        let mut out = vec![InteriorLiquid::default(); motions.len()];
         for cv in &map.covers {
             let idx = cv.cell as usize;
+            let w = cv.fraction;
             let x = [(idx % nx) as f64 + 0.5, (idx / nx) as f64 + 0.5];
             let r = crate::psm::min_image(x, motions[cv.body as usize].centre, nx, ny);
             let o = &mut out[cv.body as usize];
-            o.0 += cv.fraction;
-            o.1 += cv.fraction * (r[0] * r[0] + r[1] * r[1]);
+            o.area += w;
+            o.first[0] += w * r[0];
+            o.first[1] += w * r[1];
+            o.polar += w * (r[0] * r[0] + r[1] * r[1]);
         }
         Some(out)
     }

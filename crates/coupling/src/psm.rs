@@ -164,10 +164,11 @@ impl<T: Real> PsmFluid<T> {
     }
 
     /// Relax the liquid share of each node with two relaxation times instead of one (Ginzburg's
-    /// TRT): τ⁺ = τ sets the viscosity, τ⁻ follows from Λ = (τ⁺ − ½)(τ⁻ − ½). At τ close to ½
-    /// (the Reynolds numbers of settling-pair benchmarks) BGK's odd moments relax too fast and the
-    /// run goes unstable where TRT with Λ = 1/4 stays stable. The solid term (Eq. 11) and the
-    /// weight B (Eq. 10, from τ⁺) are unchanged.
+    /// TRT): τ⁺ = τ sets the viscosity, τ⁻ follows from Λ = (τ⁺ − ½)(τ⁻ − ½). BGK is the case
+    /// Λ = (τ − ½)²: near τ = ½ (settling pairs at Reynolds numbers of hundreds) that is about
+    /// 1e-4, the odd rate is close to 2 and the odd non-equilibrium flips sign every step and
+    /// barely decays; Λ = 1/4 damps it. The solid term (Eq. 11) and the weight B (Eq. 10, from
+    /// τ⁺) are unchanged.
     pub fn with_trt(mut self, magic: f64) -> Result<Self, CouplingError> {
         if !(magic > 0.0 && magic.is_finite()) {
             return Err(CouplingError::Unsupported(format!(
@@ -419,6 +420,11 @@ impl<T: Real> PsmFluid<T> {
             t.torque += l.torque;
         }
         Ok(())
+    }
+
+    /// BGK relaxation time (TRT: the even one, τ⁺), which sets the viscosity and B of Eq. 10.
+    pub fn tau(&self) -> f64 {
+        self.settings.tau
     }
 
     /// Whether node `idx` is updated (not in the inactive zone).

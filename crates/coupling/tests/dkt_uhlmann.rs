@@ -8,7 +8,7 @@
 //! tolerance. Through the first tumble (the pair's line of centres turning past 45° from the
 //! vertical), the run must:
 //! - follow Uhlmann's depths up to the kiss (t ≤ 0.18 s) to within 0.1 d RMS (the published
-//!   curves agree that well there);
+//!   curves differ from each other by 0.05 d RMS there, printed);
 //! - tumble within the two publications' tumble times, widened on each side by their difference.
 //!
 //! It also prints, without asserting it (the one part of the comparison not met yet), how far the
@@ -16,8 +16,11 @@
 //! publications' depths: the aim is a quarter of a diameter (this test's choice, not a published
 //! figure).
 //!
-//! CI: 16 cells per diameter (about 10 s in release). `cargo test --release -p lbdem-coupling
-//! --test dkt_uhlmann -- --ignored --nocapture` runs 24 and 32 cells per diameter and the variants
+//! The tumble time depends on the seed of the instability, the initial lateral offset (d/250
+//! either way here): at 16 cells per diameter offsets of d/500, d/250 and d/125 tumble at 0.282,
+//! 0.260 and 0.240 s, and 16 cells sits 2 ms inside the band. CI therefore runs 24 cells per
+//! diameter (tumble 14 ms inside the band; about 30 s). `cargo test --release -p lbdem-coupling
+//! --test dkt_uhlmann -- --ignored --nocapture` runs 16 and 32 cells per diameter and the variants
 //! without the interior-liquid correction and with BGK, to show what each choice does.
 
 use lbdem_coupling::cases::dkt::{DktResult, DktSpec, interpolate, run};
@@ -166,6 +169,7 @@ fn judge(label: &str, spec: &DktSpec) -> Verdict {
     let band = (tu.min(tk) - spread, tu.max(tk) + spread);
     let t_end = tu.max(tk);
     let koblitz_vs_uhlmann = k.max_depth_difference(&u, 0.0, t_end);
+    let published_drafting = k.rms_depth_difference(&u, T_KISS);
     let v = Verdict {
         rms_drafting: ours.rms_depth_difference(&u, T_KISS),
         tumble: ours.tumble_time().unwrap_or(f64::INFINITY),
@@ -174,7 +178,8 @@ fn judge(label: &str, spec: &DktSpec) -> Verdict {
     };
     eprintln!(
         "DKT {label}: {} cells/d, tau {:.4}, TRT {:?}, interior-liquid correction {}, contact range {} cells:\n  \
-         depth RMS vs Uhlmann to the kiss ({T_KISS} s) {:.3} d (limit 0.1)\n  \
+         depth RMS vs Uhlmann to the kiss ({T_KISS} s) {:.3} d (limit 0.1; Koblitz et al. vs Uhlmann \
+         {published_drafting:.3} d)\n  \
          tumble (45°) at {:.4} s; Uhlmann {tu:.4} s, Koblitz et al. {tk:.4} s, band [{:.4}, {:.4}]\n  \
          up to {t_end:.4} s: largest depth difference to Uhlmann {:.3} d (Koblitz et al.'s: {koblitz_vs_uhlmann:.3} d), \
          largest distance outside the two publications' envelope {:.3} d (aim {MARGIN}, not asserted)\n  \
@@ -222,14 +227,14 @@ fn assert_follows(v: &Verdict) {
 }
 
 #[test]
-fn two_disks_follow_the_published_trajectories_through_the_first_tumble() {
-    assert_follows(&judge("CI", &spec(16)));
+fn two_disks_draft_like_the_publications_and_tumble_within_their_band() {
+    assert_follows(&judge("CI", &spec(24)));
 }
 
 #[test]
 #[ignore]
-fn finer_lattice_and_the_variants() {
-    assert_follows(&judge("finer", &spec(24)));
+fn coarser_lattice_and_the_variants() {
+    assert_follows(&judge("coarser", &spec(16)));
     // Without the interior-liquid correction the disks fall as if they weighed ρ_p + ρ_f.
     let mut s = spec(16);
     s.interior_liquid_correction = false;

@@ -15,8 +15,8 @@ use lbdem_lbm::Domain;
 
 const TABLE: [(f64, f64); 3] = [(0.10, 24.83), (0.20, 51.53), (0.30, 102.90)];
 
-/// (F/(μU) measured with U from the fluid, Eq. 14 drag over g L²).
-fn drag(l: usize, phi: f64, tau: f64) -> (f64, f64) {
+/// (F/(μU) measured with U from the fluid, Eq. 14 drag over g L²), BGK or TRT of magic `trt`.
+fn drag_with(l: usize, phi: f64, tau: f64, trt: Option<f64>) -> (f64, f64) {
     let c = l as f64 / 2.0;
     let r = l as f64 * (phi / std::f64::consts::PI).sqrt();
     let circles = [GrainCircle {
@@ -27,12 +27,19 @@ fn drag(l: usize, phi: f64, tau: f64) -> (f64, f64) {
     let (map, motions) = fixed(&circles, l, l, [true, true]);
     let g = 1e-6;
     let mut fluid = PsmFluid::<f64>::new(&Domain::periodic([l, l, 1]), settings(tau, [g, 0.0])).unwrap();
+    if let Some(m) = trt {
+        fluid = fluid.with_trt(m).unwrap();
+    }
     let (loads, _) = run_steady(&mut fluid, &map, &motions, 500, 1e-8, 200_000);
     let nu = (tau - 0.5) / 3.0;
     let u = mean_u(&fluid)[0];
     let total = g * (l * l) as f64;
     let liquid: f64 = map.total.iter().map(|&e| 1.0 - psm_weight(e, tau)).sum();
     (total / (nu * u), loads[0].force[0] / (g * liquid))
+}
+
+fn drag(l: usize, phi: f64, tau: f64) -> (f64, f64) {
+    drag_with(l, phi, tau, None)
 }
 
 /// Errors at `phis` (indices into TABLE); each within `tol`.
@@ -78,4 +85,29 @@ fn drag_matches_table_full() {
     for (c, f) in coarse.iter().zip(&fine) {
         assert!(*f < 0.5 * c, "no convergence: {coarse:?} -> {fine:?}");
     }
+}
+
+/// The TRT liquid collision (Ginzburg's two rates, `PsmFluid::with_trt`): with the magic
+/// parameter Λ = (τ − ½)² its odd rate equals the even one, so it must reproduce BGK to
+/// round-off; with Λ = 1/4 at τ = 0.6 it must meet the same Sangani-Acrivos tolerance as BGK at
+/// L = 32 (Φ = 0.2), and its Eq. 14 drag must still balance the force put into the liquid.
+#[test]
+fn trt_reduces_to_bgk_and_meets_the_table() {
+    let tau = 0.6;
+    let (phi, want) = TABLE[1];
+    let (bgk, _) = drag_with(32, phi, tau, None);
+    let (same, _) = drag_with(32, phi, tau, Some((tau - 0.5) * (tau - 0.5)));
+    assert!(
+        (same - bgk).abs() < 1e-9 * bgk,
+        "TRT with Λ = (τ-½)²: {same} vs BGK {bgk}"
+    );
+    let (trt, balance) = drag_with(32, phi, tau, Some(0.25));
+    let err = (trt - want) / want;
+    eprintln!(
+        "PSM TRT (Λ = 1/4) L=32 tau={tau} phi={phi}: F/(mu U) = {trt:.3} (BGK {bgk:.3}), Sangani-Acrivos {want}, \
+         error {:+.2}%, balance {balance:.6}",
+        100.0 * err
+    );
+    assert!((balance - 1.0).abs() < 1e-4, "force balance {balance}");
+    assert!(err.abs() < 0.07, "TRT: {trt} vs {want}");
 }

@@ -202,24 +202,15 @@ fn run_with<T: Real>(cfg: &CoupledScene, ctx: &SimContext) -> Result<StageOutput
     let mut run = Coupled::new(hydro, sys, law, wall_law, cfg.step, units, cfg.coupling.r_hd)
         .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;
     run.depth = cfg.coupling.depth;
-    if cfg.coupling.interior_liquid_correction {
-        // Particle densities are per sample depth (kg/m²).
-        let lightest = run
-            .sys
-            .bodies
-            .density
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
-        let ratio = lightest / cfg.coupling.depth / cfg.fluid.density;
-        run = run
-            .with_interior_liquid_correction(ratio)
-            .map_err(|e| anyhow::anyhow!("[coupling] interior_liquid_correction = true: {e}"))?;
-    }
     if cfg.coupling.dry_membrane {
         for k in 0..run.sys.bodies.len() {
             run.dry[k] = run.sys.bodies.tag[k] == 1;
         }
+    }
+    if cfg.coupling.interior_liquid_correction {
+        run = run
+            .with_interior_liquid_correction()
+            .map_err(|e| anyhow::anyhow!("[coupling] interior_liquid_correction = true: {e}"))?;
     }
     eprintln!(
         "coupled: {} grains, lattice {nx} x {ny} (dx = {dx:e} m, tau = {tau:.4}), LBM dt = {:e} s, \

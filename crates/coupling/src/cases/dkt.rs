@@ -168,7 +168,7 @@ pub fn run<T: Real>(spec: &DktSpec) -> Result<DktResult, CouplingError> {
     params.gravity_factor = 1.0 - spec.rho_f / spec.rho_p;
     let mut run = Coupled::new(Hydro::psm(fluid), sys, law.clone(), law, params, units, r_hd)?;
     if spec.interior_liquid_correction {
-        run = run.with_interior_liquid_correction(spec.rho_p / spec.rho_f)?;
+        run = run.with_interior_liquid_correction()?;
     }
 
     let steps = (spec.duration / dt).ceil() as u64;
