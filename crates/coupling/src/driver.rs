@@ -152,7 +152,7 @@ impl<T: Real> Coupled<T> {
     /// motion to its present one takes (Uhlmann, J. Comput. Phys. 209 (2005) 448, Eq. 15, the
     /// rigid-body approximation of the interior liquid), with the weights of
     /// [`Hydro::interior_liquid`]. It is explicit; Uhlmann reports it stable for density ratios
-    /// down to about 1.2, a limit adopted here without a test of its own, so the lightest grain
+    /// down to about 1.2 (`tests/added_mass.rs` checks 1.25, not below), so the lightest grain
     /// that feels the liquid must be at least 1.2 times denser than it.
     ///
     /// With it on, [`Coupled::momentum`] (all the liquid plus the grains) is no longer conserved:
