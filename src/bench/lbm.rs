@@ -5,9 +5,10 @@
 //! The bound of the in-place AA kernel (lbdem's default, 2 x 9 values moved per node update, no
 //! write-allocate) is the largest node-update rate of, per repetition:
 //! - the **fused in-place pass** (`lbdem_lbm::roofline::in_place_pass`): one read-modify-write pass
-//!   over all 9 direction arrays of an array in the AA stepper's own padded layout, rows in one
-//!   contiguous range per thread, blocks of two AVX-512 registers, one multiply per value: the AA
-//!   kernel's bytes with the least work, so no correct kernel on that array runs faster;
+//!   over all 9 direction arrays of an array in the AA stepper's own padded layout, rows spread
+//!   over the threads as the stepper spreads them (tasks of 4 rows, work stealing), blocks of two
+//!   AVX-512 registers, one multiply per value: the AA kernel's bytes with the least work, so no
+//!   correct kernel on that array runs faster;
 //! - the **nine-pass ceiling** (the benchmark's former reference, kept for comparison): nine separate
 //!   parallel in-place passes, one per array; on 2 threads it runs below the fused pass and lbmpy
 //!   beat it, so alone it is *not* a bound;
@@ -173,12 +174,12 @@ impl<T: Real> AaCase<T> {
                 self.st.step(&mut self.fluid, None)?;
             }
             let kernel = (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6;
-            let (lay, base) = (self.layout, self.layout.base);
+            let (lay, base, part) = (self.layout, self.layout.base, self.st.partition);
             let f = &mut self.fused;
             let mut flip = false;
             let fused = rate(n, steps, || {
                 flip = !flip;
-                roofline::in_place_pass(&mut f[base..], &lay, Q, ny, if flip { s } else { s_inv });
+                roofline::in_place_pass(&mut f[base..], &lay, Q, ny, part, if flip { s } else { s_inv });
             });
             let nine = &mut self.nine;
             let mut flip = false;

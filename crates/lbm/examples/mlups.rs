@@ -62,7 +62,7 @@ fn run<T: Real>(nx: usize, ny: usize, reps: usize, collision: Collision, two: bo
     let mut bound = || {
         let t = Instant::now();
         for _ in 0..steps {
-            roofline::in_place_pass(&mut g[lay.base..], &lay, 9, ny, s);
+            roofline::in_place_pass(&mut g[lay.base..], &lay, 9, ny, Partition::Rows(4), s);
         }
         (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6
     };

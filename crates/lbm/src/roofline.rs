@@ -1,8 +1,11 @@
 //! Memory-traffic bound of the in-place AA kernel, for benchmarks: one fused read-modify-write
 //! pass over all Q direction arrays of a population array in the AA stepper's own (padded)
-//! layout, written the way the kernel walks memory (rows split into one contiguous range per
-//! thread of the caller's rayon pool, blocks of two AVX-512 registers across all Q arrays, plain
+//! layout, written the way the kernel walks memory (rows spread over the caller's rayon pool with
+//! the same `Partition` as the stepper, blocks of two AVX-512 registers across all Q arrays, plain
 //! loads and stores, no non-temporal stores), with no arithmetic beyond one multiply per value.
+//! With the same partition it also meets the same scheduling: on a shared machine, where another
+//! process takes a core now and then, a static split (`Partition::Contiguous`) loses more than
+//! work stealing (`Partition::Rows`), for the pass as for the kernel.
 //! It moves exactly the AA kernel's bytes per node update (Q reads + Q writes, no write-allocate
 //! since every written line was just read) with the least work a kernel can do on them, so a
 //! correct stream-collide kernel on the same array cannot run faster: node updates per second
@@ -11,6 +14,7 @@
 use crate::kernel::{SyncPtr, wide};
 use crate::layout::Layout;
 use crate::real::Real;
+use crate::stepper_aa::Partition;
 use rayon::prelude::*;
 
 /// Multiply every fluid slot (the `nx` leading slots of each of `rows` rows) of `q` direction arrays
@@ -18,22 +22,39 @@ use rayon::prelude::*;
 ///
 /// # Panics
 /// If `f` is shorter than `q` direction arrays of the layout.
-pub fn in_place_pass<T: Real>(f: &mut [T], layout: &Layout, q: usize, rows: usize, scale: T) {
+pub fn in_place_pass<T: Real>(
+    f: &mut [T],
+    layout: &Layout,
+    q: usize,
+    rows: usize,
+    partition: Partition,
+    scale: T,
+) {
     assert!(
         f.len() >= (q - 1) * layout.stride + rows * layout.nxp,
         "array too short for the layout"
     );
     let ptr = SyncPtr(f.as_mut_ptr());
-    let per = rows.div_ceil(rayon::current_num_threads()).max(1);
-    let ranges: Vec<(usize, usize)> = (0..rows).step_by(per).map(|r| (r, (r + per).min(rows))).collect();
-    ranges.par_iter().with_max_len(1).for_each(|&(r0, r1)| {
+    let task = |t: usize, per: usize| {
         let p = &ptr;
-        for r in r0..r1 {
-            // SAFETY: rows [r0, r1) of every array belong to this task only; indices in bounds
-            // (asserted above).
+        for r in t * per..((t + 1) * per).min(rows) {
+            // SAFETY: rows of a task belong to it only; indices in bounds (asserted above).
             unsafe { row(p.0.add(r * layout.nxp), layout.stride, layout.nx, q, scale) };
         }
-    });
+    };
+    match partition {
+        Partition::Rows(k) => {
+            let k = k.max(1);
+            (0..rows.div_ceil(k)).into_par_iter().for_each(|t| task(t, k));
+        }
+        Partition::Contiguous => {
+            let per = rows.div_ceil(rayon::current_num_threads()).max(1);
+            (0..rows.div_ceil(per))
+                .into_par_iter()
+                .with_max_len(1)
+                .for_each(|t| task(t, per));
+        }
+    }
 }
 
 /// One row: blocks of `kernel::wide::<T>()` nodes across all `q` arrays, then the scalar rest.
@@ -71,11 +92,13 @@ mod tests {
         let mut f = lay.pack(&canon, 9);
         let base = lay.base;
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-        pool.install(|| in_place_pass(&mut f[base..], &lay, 9, 5, 2.0));
+        for p in [Partition::Rows(2), Partition::Contiguous] {
+            pool.install(|| in_place_pass(&mut f[base..], &lay, 9, 5, p, 2.0));
+        }
         let back = lay.unpack(&f, 9, 37 * 5);
-        assert!(back.iter().zip(&canon).all(|(b, c)| *b == 2.0 * c));
+        assert!(back.iter().zip(&canon).all(|(b, c)| *b == 4.0 * c));
         // padding slots stay zero
         let total: f64 = f.iter().sum();
-        assert_eq!(total, 2.0 * canon.iter().sum::<f64>());
+        assert_eq!(total, 4.0 * canon.iter().sum::<f64>());
     }
 }
