@@ -1,7 +1,8 @@
-//! Development speed probe of one configuration (the benchmark proper, with the STREAM-style
-//! ceilings and the peer, is `lbdem bench lbm`). Each repetition times the kernel and, right
-//! after it, an in-place update of 9 arrays of the same size (the AA kernel's traffic), so that the
-//! printed ratio is robust to other load on the machine.
+//! Development speed probe of one configuration (the benchmark proper, with STREAM and the peer,
+//! is `lbdem bench lbm`). Each repetition times the AA kernel once per row partition
+//! (`Partition::Rows(4)`, then `Partition::Contiguous`: an A/B of the partition in one process),
+//! then the nine-pass in-place ceiling and the fused in-place bound (`roofline::in_place_pass`)
+//! on arrays of the same size, so that the printed ratios are robust to other load on the machine.
 //! `cargo run --release -p lbdem-lbm --example mlups -- NX NY f64|f32 THREADS [REPS] [bgk|trt] [aa|two] [WORK]`
 
 use lbdem_lbm::layout::Layout;
