@@ -39,7 +39,9 @@ fi
 [ -n "$BENCH" ] && [ -f "$BENCH" ] || { echo "peer-lbmpy: driver lbmpy_bench.py not found in ../shared/peers or ../../shared/peers; set LBMPY_BENCH=path" >&2; exit 2; }
 install
 SIZE="$1" DTYPE="$2" THREADS="$3" VARIANT="${4:-aa}"
-export OMP_PROC_BIND=close OMP_PLACES=cores
+# threads pinned to cores unless the caller says otherwise (OMP_PROC_BIND=false lets the OS move a
+# thread off a core another process is using)
+export OMP_PROC_BIND="${OMP_PROC_BIND:-close}" OMP_PLACES="${OMP_PLACES:-cores}"
 OMP_NUM_THREADS="$THREADS" "$PY" "$BENCH" --stencil D2Q9 --size "$SIZE" --dtype "$DTYPE" \
     --variant "$VARIANT" --blocks "${LBMPY_BLOCKS:-5}" --block-time "${LBMPY_BLOCK_TIME:-1.0}" \
     --warmup-time 0.5 --cache "$ROOT/target/peer-lbmpy-cache" 2>/dev/null | tail -n 1

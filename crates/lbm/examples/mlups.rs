@@ -1,10 +1,14 @@
-//! Development speed probe of one configuration (the benchmark proper, with the STREAM-style
-//! ceilings and the peer, is `lbdem bench lbm`). Each repetition times the kernel and, right
-//! after it, an in-place update of 9 arrays of the same size (the AA kernel's traffic), so that the
-//! printed ratio is robust to other load on the machine.
+//! Development speed probe of one configuration (the benchmark proper, with STREAM and the peer,
+//! is `lbdem bench lbm`). Each repetition times the AA kernel once per row partition
+//! (`Partition::Rows(4)`, then `Partition::Contiguous`: an A/B of the partition in one process),
+//! then the nine-pass in-place ceiling and the fused in-place bound (`roofline::in_place_pass`)
+//! on arrays of the same size, so that the printed ratios are robust to other load on the machine.
 //! `cargo run --release -p lbdem-lbm --example mlups -- NX NY f64|f32 THREADS [REPS] [bgk|trt] [aa|two] [WORK]`
 
-use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Limits, Real, Settings, Stepper, StepperAa};
+use lbdem_lbm::layout::Layout;
+use lbdem_lbm::{
+    Collision, D2Q9, Domain, Fluid, Limits, Partition, Real, Settings, Stepper, StepperAa, roofline,
+};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -53,36 +57,69 @@ fn run<T: Real>(nx: usize, ny: usize, reps: usize, collision: Collision, two: bo
     } else {
         (None, Some(StepperAa::new(&mut fluid, settings).unwrap()))
     };
-    let (mut rates, mut ceils, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
-    for rep in 0..=reps {
+    // the fused in-place bound on an array in the AA stepper's own layout
+    let mut lay = Layout::padded::<T>([nx, ny, 1]);
+    let mut g = lay.pack(&vec![T::from_f64(1.0); 9 * n], 9);
+    let mut bound = || {
         let t = Instant::now();
         for _ in 0..steps {
-            match (aa_st.as_mut(), two_st.as_mut()) {
-                (Some(a), _) => a.step(&mut fluid, None).unwrap(),
-                (None, Some(b)) => b.step(&mut fluid, None).unwrap(),
-                _ => unreachable!(),
-            }
+            roofline::in_place_pass(&mut g[lay.base..], &lay, 9, ny, Partition::Rows(4), s);
         }
-        let r = (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6;
+        (n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6
+    };
+    // AA: each partition in turn; two-array: one entry
+    let parts: Vec<Option<Partition>> = if two {
+        vec![None]
+    } else {
+        vec![Some(Partition::Rows(4)), Some(Partition::Contiguous)]
+    };
+    let mut rates = vec![Vec::new(); parts.len()];
+    let (mut ceils, mut bounds) = (Vec::new(), Vec::new());
+    for rep in 0..=reps {
+        let mut r = Vec::new();
+        for p in &parts {
+            let t = Instant::now();
+            for _ in 0..steps {
+                match (aa_st.as_mut(), two_st.as_mut()) {
+                    (Some(a), _) => {
+                        a.partition = p.unwrap();
+                        a.step(&mut fluid, None).unwrap()
+                    }
+                    (None, Some(b)) => b.step(&mut fluid, None).unwrap(),
+                    _ => unreachable!(),
+                }
+            }
+            r.push((n * steps) as f64 / t.elapsed().as_secs_f64() / 1e6);
+        }
         let cl = ceiling();
+        let bd = bound();
         if rep > 0 {
-            rates.push(r);
+            for (k, x) in r.into_iter().enumerate() {
+                rates[k].push(x);
+            }
             ceils.push(cl);
-            ratios.push(r / cl);
+            bounds.push(bd);
         }
     }
+    let b = median(bounds.clone());
     println!(
-        "{nx}x{ny} {} {} t={}: {:.1} MLUPS (best {:.1}), in-place ceiling {:.1} (best {:.1}), ratio {:.0}% (median of {reps}; ratios {:?})",
+        "{nx}x{ny} {} {} t={}: fused in-place bound {:.1} MLUPS, nine-pass ceiling {:.1} (medians of {reps})",
         T::NAME,
         if two { "two-array" } else { "AA" },
         rayon::current_num_threads(),
-        median(rates.clone()),
-        rates.iter().cloned().fold(0.0, f64::max),
+        b,
         median(ceils.clone()),
-        ceils.iter().cloned().fold(0.0, f64::max),
-        100.0 * median(ratios.clone()),
-        ratios.iter().map(|r| (100.0 * r).round()).collect::<Vec<_>>()
     );
+    for (p, r) in parts.iter().zip(&rates) {
+        let ratios: Vec<f64> = r.iter().zip(&bounds).map(|(x, y)| x / y).collect();
+        println!(
+            "  {:?}: {:.1} MLUPS, {:.0}% of the bound (per-rep ratios {:?})",
+            p,
+            median(r.clone()),
+            100.0 * median(ratios.clone()),
+            ratios.iter().map(|r| (100.0 * r).round()).collect::<Vec<_>>()
+        );
+    }
 }
 
 fn main() {

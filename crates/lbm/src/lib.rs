@@ -19,6 +19,7 @@ pub mod lattice;
 pub mod layout;
 pub mod plan;
 pub mod real;
+pub mod roofline;
 pub mod stepper;
 pub mod stepper_aa;
 pub mod zouhe;
@@ -29,7 +30,7 @@ pub use kernel::Limits;
 pub use lattice::{D2Q9, D3Q19, Lattice};
 pub use real::Real;
 pub use stepper::{Fluid, ForceTorque, Macro, Settings, Stepper};
-pub use stepper_aa::StepperAa;
+pub use stepper_aa::{Partition, StepperAa};
 
 /// Errors of the LBM engine; each names the parameter, its value, the limit and the fix.
 #[derive(Debug, thiserror::Error)]

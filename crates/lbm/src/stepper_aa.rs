@@ -19,6 +19,16 @@ use std::marker::PhantomData;
 
 const ROWS_PER_TASK: usize = 4;
 
+/// How the rows of one step are spread over the rayon pool (results do not depend on it: every
+/// node reads and writes only its own slots).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Partition {
+    /// Tasks of this many rows, taken by whichever thread is free (work stealing).
+    Rows(usize),
+    /// One contiguous range of rows per thread of the pool (OpenMP `schedule(static)`).
+    Contiguous,
+}
+
 pub struct StepperAa<L: Lattice, T: Real> {
     settings: Settings,
     params: CollideParams<T>,
@@ -29,6 +39,8 @@ pub struct StepperAa<L: Lattice, T: Real> {
     motions: Vec<Motion>,
     /// True when the array is in the reversed layout (next step is odd).
     reversed: bool,
+    /// Row partition over the pool (default `Rows(4)`).
+    pub partition: Partition,
     pub forces: Vec<ForceTorque>,
     _l: PhantomData<L>,
 }
@@ -78,6 +90,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             bad: vec![None; dom.n[1] * dom.n[2]],
             motions,
             reversed: true,
+            partition: Partition::Rows(ROWS_PER_TASK),
             forces: vec![ForceTorque::default(); fluid.obstacles.len() + 6],
             _l: PhantomData,
         })
@@ -94,6 +107,11 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         fluid.f = self.layout.unpack(&fluid.f, L::Q, n);
         swap_pairs::<L, T>(&mut fluid.f, n);
         Ok(())
+    }
+
+    /// The padded layout the array is kept in between `new` and `finish`.
+    pub fn layout(&self) -> Layout {
+        self.layout
     }
 
     /// Obstacle motions may change between steps (coupling); geometry changes need a new stepper.
@@ -126,23 +144,34 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         };
         let odd = self.reversed;
         let forced = self.settings.force.iter().any(|&x| x != 0.0);
-        self.bad
-            .par_chunks_mut(ROWS_PER_TASK)
-            .enumerate()
-            .for_each(|(c, flags)| {
-                for (k, b) in flags.iter_mut().enumerate() {
-                    let r = c * ROWS_PER_TASK + k;
-                    // SAFETY: every node touches only its own slots (kernel_aa module doc).
-                    *b = unsafe {
-                        match (odd, forced) {
-                            (true, true) => kernel_aa::odd_row::<L, T, true>(&ctx, r),
-                            (true, false) => kernel_aa::odd_row::<L, T, false>(&ctx, r),
-                            (false, true) => kernel_aa::even_row::<L, T, true>(&ctx, r),
-                            (false, false) => kernel_aa::even_row::<L, T, false>(&ctx, r),
-                        }
-                    };
-                }
-            });
+        let work = |(c, flags): (usize, &mut [Bad]), rows: usize| {
+            for (k, b) in flags.iter_mut().enumerate() {
+                let r = c * rows + k;
+                // SAFETY: every node touches only its own slots (kernel_aa module doc).
+                *b = unsafe {
+                    match (odd, forced) {
+                        (true, true) => kernel_aa::odd_row::<L, T, true>(&ctx, r),
+                        (true, false) => kernel_aa::odd_row::<L, T, false>(&ctx, r),
+                        (false, true) => kernel_aa::even_row::<L, T, true>(&ctx, r),
+                        (false, false) => kernel_aa::even_row::<L, T, false>(&ctx, r),
+                    }
+                };
+            }
+        };
+        match self.partition {
+            Partition::Rows(k) => {
+                let k = k.max(1);
+                self.bad.par_chunks_mut(k).enumerate().for_each(|t| work(t, k));
+            }
+            Partition::Contiguous => {
+                let k = self.bad.len().div_ceil(rayon::current_num_threads());
+                self.bad
+                    .par_chunks_mut(k)
+                    .with_max_len(1)
+                    .enumerate()
+                    .for_each(|t| work(t, k));
+            }
+        }
         self.reversed = !self.reversed;
         fluid.step += 1;
         if let Some((r, Some((x, rho, u)))) = self.bad.iter().enumerate().find(|(_, b)| b.is_some()) {

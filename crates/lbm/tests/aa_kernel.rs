@@ -5,7 +5,9 @@
 #![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
-use lbdem_lbm::{Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, Motion, Real, Stepper, StepperAa};
+use lbdem_lbm::{
+    Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, Motion, Partition, Real, Stepper, StepperAa,
+};
 
 fn setup<L: Lattice, T: Real>(n: [usize; 3]) -> Fluid<L, T> {
     let lid = Face::Wall {
@@ -114,7 +116,7 @@ fn aa_equals_two_array_d3q19() {
 
 #[test]
 fn aa_identical_for_one_and_two_threads() {
-    let run = |threads: usize| {
+    let run = |threads: usize, partition: Partition| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
@@ -123,6 +125,7 @@ fn aa_identical_for_one_and_two_threads() {
             let mut fl = setup::<D2Q9, f64>([64, 48, 1]);
             let s = settings(Collision::Bgk { tau: 0.6 }, [1e-5, 0.0, 0.0]);
             let mut aa = StepperAa::new(&mut fl, s).unwrap();
+            aa.partition = partition;
             for _ in 0..100 {
                 aa.step(&mut fl, None).unwrap();
             }
@@ -130,6 +133,16 @@ fn aa_identical_for_one_and_two_threads() {
             fl.f
         })
     };
-    let (a, b) = (run(1), run(2));
-    assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+    let a = run(1, Partition::Rows(4));
+    for (threads, p) in [
+        (2, Partition::Rows(4)),
+        (2, Partition::Contiguous),
+        (1, Partition::Contiguous),
+    ] {
+        let b = run(threads, p);
+        assert!(
+            a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{threads} threads, {p:?}"
+        );
+    }
 }
