@@ -10,6 +10,7 @@ pub mod domain;
 pub mod error;
 pub mod generate;
 pub mod neighbor;
+mod pair_linear;
 pub mod shape;
 pub mod stepper;
 pub mod system;

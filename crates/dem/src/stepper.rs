@@ -10,8 +10,10 @@
 //! at which the Verlet list was rebuilt (a resumed run continues bit for bit).
 
 use crate::contact::{ContactInput, ContactLaw, History, Law, LinearSpringDashpot};
+use crate::domain::Domain;
 use crate::error::DemError;
 use crate::neighbor::{CellList, carry_history};
+use crate::pair_linear::{LinearPair, PairSlices};
 use crate::system::System;
 use crate::vector::{Vec2, Vector};
 use crate::wall::update_wall_velocities;
@@ -54,34 +56,32 @@ impl StepParams {
     }
 }
 
-/// Reaction of pair (i, j) on circle j: force and torque (zero when the pair does not touch).
-#[derive(Clone, Copy, Debug, Default)]
-struct JOut {
-    f: Vec2,
-    t: f64,
-}
-
-/// Sum over the pairs (i, j > i) of circle i: force, torque and number of touching pairs.
-#[derive(Clone, Copy, Debug, Default)]
-struct Acc {
-    f: Vec2,
-    t: f64,
-    n: u32,
-}
-
-/// Circles per parallel task of the pair pass (any value gives the same bits).
-const PAIR_CHUNK: usize = 512;
+/// Pairs per parallel task of the pair pass (any value gives the same bits).
+const PAIR_CHUNK: usize = 2048;
 
 /// What the pair loop reads of a circle, packed in one cache line.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(64))]
-struct CircleState {
-    pos: Vec2,
+pub(crate) struct CircleState {
+    pub pos: Vec2,
     /// Velocity of the circle centre.
-    vel: Vec2,
-    omega: f64,
-    r: f64,
-    mass: f64,
+    pub vel: Vec2,
+    pub omega: f64,
+    pub r: f64,
+    pub mass: f64,
+    /// Fills the line (the pair kernel loads whole lines).
+    pub pad: f64,
+}
+
+impl CircleState {
+    /// The line as eight numbers: x, y, vx, vy, ω, r, m, 0 (portable pair kernel).
+    #[cfg(not(target_feature = "avx512f"))]
+    #[inline(always)]
+    pub(crate) fn line(&self) -> [f64; 8] {
+        [
+            self.pos.x, self.pos.y, self.vel.x, self.vel.y, self.omega, self.r, self.mass, self.pad,
+        ]
+    }
 }
 
 /// Scratch for stepping a [`System`].
@@ -94,9 +94,13 @@ pub struct Stepper {
     ref_pos: Vec<Vec2>,
     /// Pairs of circle i (as the lower index) are `pair_start[i]..pair_start[i + 1]`.
     pair_start: Vec<u32>,
-    /// Reaction slots, one per pair.
-    out_j: Vec<JOut>,
-    acc: Vec<Acc>,
+    /// Result of every pair (force on i, torques on i and j; zero when not touching) and
+    /// whether it touches (1) or not (0).
+    out_fx: Vec<f64>,
+    out_fy: Vec<f64>,
+    out_ti: Vec<f64>,
+    out_tj: Vec<f64>,
+    touch: Vec<u8>,
     /// Per circle: the pairs in which it is j, ascending i (indices into `out_j`).
     j_start: Vec<u32>,
     j_list: Vec<u32>,
@@ -152,7 +156,7 @@ impl Stepper {
 
     /// Number of pairs in contact at the last force evaluation.
     pub fn n_contacts(&self) -> usize {
-        self.acc.iter().map(|a| a.n as usize).sum()
+        self.touch.iter().map(|&t| t as usize).sum()
     }
 
     /// Advance `sys` by one step.
@@ -246,6 +250,7 @@ impl Stepper {
                     omega: *w,
                     r: rad[k],
                     mass: mass[k],
+                    pad: 0.0,
                 };
                 dom.min_image(*x - refp[k]).norm2()
             })
@@ -303,6 +308,7 @@ impl Stepper {
                     omega: b.omega[k],
                     r: b.circle_r[c],
                     mass: b.mass[k],
+                    pad: 0.0,
                 };
                 if have_ref {
                     dom.min_image(*x - refp[c]).norm2()
@@ -353,8 +359,15 @@ impl Stepper {
             self.j_list[fill[c] as usize] = k as u32;
             fill[c] += 1;
         }
-        self.out_j.resize(pairs.len(), JOut::default());
-        self.acc.resize(nc, Acc::default());
+        for v in [
+            &mut self.out_fx,
+            &mut self.out_fy,
+            &mut self.out_ti,
+            &mut self.out_tj,
+        ] {
+            v.resize(pairs.len(), 0.0);
+        }
+        self.touch.resize(pairs.len(), 0);
         self.rebuilds += 1;
         Ok(())
     }
@@ -364,77 +377,34 @@ impl Stepper {
         let dt = p.dt;
         let dom = sys.domain;
         let (carm, cst) = (&self.carm, &self.cstate);
-        // 1. Pairs by circle i, in parallel over fixed chunks of circles: the force on i summed
-        //    in ascending j, the reaction on j into the pair's slot.
+        // 1. Every pair, in parallel over fixed chunks of pairs: force on i, torques on i and j.
         {
-            let ps = &self.pair_start;
-            let nc = cst.len();
             let pairs = &sys.contacts.pairs;
-            let mut tasks = Vec::with_capacity(nc.div_ceil(PAIR_CHUNK));
-            let (mut hist, mut outj) = (&mut sys.contacts.hist[..], &mut self.out_j[..]);
-            for (k, acc) in self.acc.chunks_mut(PAIR_CHUNK).enumerate() {
-                let (c0, c1) = (k * PAIR_CHUNK, (k * PAIR_CHUNK + acc.len()));
-                let len = (ps[c1] - ps[c0]) as usize;
-                let (h, hr) = hist.split_at_mut(len);
-                let (o, or) = outj.split_at_mut(len);
-                hist = hr;
-                outj = or;
-                tasks.push((c0, acc, h, o));
-            }
-            tasks.into_par_iter().for_each(|(c0, acc, hist, outj)| {
-                let base = ps[c0] as usize;
-                for (di, a) in acc.iter_mut().enumerate() {
-                    let i = c0 + di;
-                    let ci = &cst[i];
-                    let (mut fa, mut ta, mut na) = (Vec2::ZERO, 0.0, 0u32);
-                    let (q0, q1) = (ps[i] as usize, ps[i + 1] as usize);
-                    for ((pr, h), o) in pairs[q0..q1]
-                        .iter()
-                        .zip(hist[q0 - base..q1 - base].iter_mut())
-                        .zip(outj[q0 - base..q1 - base].iter_mut())
-                    {
-                        let cj = &cst[pr[1] as usize];
-                        let d = dom.min_image(cj.pos - ci.pos);
-                        let (ri, rj) = (ci.r, cj.r);
-                        let rs = ri + rj;
-                        let d2 = d.norm2();
-                        if d2 >= rs * rs {
-                            if *h != History::default() {
-                                *h = History::default();
-                            }
-                            *o = JOut::default();
-                            continue;
-                        }
-                        let dist = d2.sqrt();
-                        let n = d * (1.0 / dist);
-                        let delta = rs - dist;
-                        let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
-                        let (wi, wj) = (ci.omega, cj.omega);
-                        let vi = ci.vel + (n * ai).spin(wi);
-                        let vj = cj.vel - (n * aj).spin(wj);
-                        let (mi, mj) = (ci.mass, cj.mass);
-                        let c = ContactInput {
-                            delta,
-                            n,
-                            v_rel: vi - vj,
-                            w_rel: wi - wj,
-                            r_eff: ri * rj / rs,
-                            m_eff: mi * mj / (mi + mj),
-                            dt,
-                        };
-                        let r = law.force(&c, h);
-                        let nxf = n.cross(r.f);
-                        fa += r.f;
-                        ta += ai * nxf + r.m_roll;
-                        na += 1;
-                        *o = JOut {
-                            f: -r.f,
-                            t: aj * nxf - r.m_roll,
-                        };
+            let n = pairs.len();
+            let hist = &mut sys.contacts.hist[..n];
+            let fast = law.linear().and_then(|l| LinearPair::new(l, &dom, dt));
+            let ch = PAIR_CHUNK;
+            pairs
+                .par_chunks(ch)
+                .zip(hist.par_chunks_mut(ch))
+                .zip(self.touch[..n].par_chunks_mut(ch))
+                .zip(
+                    self.out_fx[..n]
+                        .par_chunks_mut(ch)
+                        .zip(self.out_fy[..n].par_chunks_mut(ch)),
+                )
+                .zip(
+                    self.out_ti[..n]
+                        .par_chunks_mut(ch)
+                        .zip(self.out_tj[..n].par_chunks_mut(ch)),
+                )
+                .for_each(|((((pairs, hist), touch), (fx, fy)), (ti, tj))| {
+                    let out = PairSlices { fx, fy, ti, tj };
+                    match &fast {
+                        Some(k) => k.run(cst, pairs, hist, out, touch),
+                        None => generic_pairs(law, &dom, dt, cst, pairs, hist, out, touch),
                     }
-                    *a = Acc { f: fa, t: ta, n: na };
-                }
-            });
+                });
         }
         // 2. Per body: each circle's own sum plus its reactions in ascending i. Without walls,
         //    bonds or membrane nothing else adds to the contact forces, so body forces, damping
@@ -447,13 +417,21 @@ impl Stepper {
             h,
         };
         let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
-        let (outj, acc, js, jl) = (&self.out_j, &self.acc, &self.j_start, &self.j_list);
+        let (ofx, ofy, oti, otj) = (&self.out_fx, &self.out_fy, &self.out_ti, &self.out_tj);
+        let (ps, js, jl) = (&self.pair_start, &self.j_start, &self.j_list);
+        // Circle c: its pairs as i in ascending j, then as j in ascending i (the reaction −f).
         let circle_sum = |c: usize| -> (Vec2, f64) {
-            let (mut fc, mut tc) = (acc[c].f, acc[c].t);
+            let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
+            for q in ps[c] as usize..ps[c + 1] as usize {
+                fc.x += ofx[q];
+                fc.y += ofy[q];
+                tc += oti[q];
+            }
             for &q in &jl[js[c] as usize..js[c + 1] as usize] {
-                let o = &outj[q as usize];
-                fc += o.f;
-                tc += o.t;
+                let q = q as usize;
+                fc.x -= ofx[q];
+                fc.y -= ofy[q];
+                tc += otj[q];
             }
             (fc, tc)
         };
@@ -615,6 +593,59 @@ impl Stepper {
             .for_each(|(k, ((f, t), (v, w)))| {
                 fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
             });
+    }
+}
+
+/// The pair pass for any law: force on i, torques on i and j, touching flag.
+#[allow(clippy::too_many_arguments)]
+fn generic_pairs<L: ContactLaw>(
+    law: &L,
+    dom: &Domain,
+    dt: f64,
+    cst: &[CircleState],
+    pairs: &[[u32; 2]],
+    hist: &mut [History],
+    out: PairSlices<'_>,
+    touch: &mut [u8],
+) {
+    for (q, ((pr, h), t)) in pairs.iter().zip(hist).zip(touch).enumerate() {
+        let (ci, cj) = (&cst[pr[0] as usize], &cst[pr[1] as usize]);
+        let d = dom.min_image(cj.pos - ci.pos);
+        let (ri, rj) = (ci.r, cj.r);
+        let rs = ri + rj;
+        let d2 = d.norm2();
+        if d2 >= rs * rs {
+            if *h != History::default() {
+                *h = History::default();
+            }
+            (out.fx[q], out.fy[q], out.ti[q], out.tj[q]) = (0.0, 0.0, 0.0, 0.0);
+            *t = 0;
+            continue;
+        }
+        let dist = d2.sqrt();
+        let n = d * (1.0 / dist);
+        let delta = rs - dist;
+        let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
+        let (wi, wj) = (ci.omega, cj.omega);
+        let vi = ci.vel + (n * ai).spin(wi);
+        let vj = cj.vel - (n * aj).spin(wj);
+        let (mi, mj) = (ci.mass, cj.mass);
+        let c = ContactInput {
+            delta,
+            n,
+            v_rel: vi - vj,
+            w_rel: wi - wj,
+            r_eff: ri * rj / rs,
+            m_eff: mi * mj / (mi + mj),
+            dt,
+        };
+        let r = law.force(&c, h);
+        let nxf = n.cross(r.f);
+        out.fx[q] = r.f.x;
+        out.fy[q] = r.f.y;
+        out.ti[q] = ai * nxf + r.m_roll;
+        out.tj[q] = aj * nxf - r.m_roll;
+        *t = 1;
     }
 }
 
