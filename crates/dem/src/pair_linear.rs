@@ -6,7 +6,7 @@
 
 use crate::contact::{Damping, History, LinearSpringDashpot};
 use crate::domain::Domain;
-use crate::stepper::CircleState;
+use crate::stepper::{CircleState, PairOut};
 
 /// The law and box constants of one force evaluation.
 #[derive(Clone, Copy, Debug)]
@@ -61,7 +61,7 @@ impl LinearPair {
         cst: &[CircleState],
         pairs: &[[u32; 2]],
         hist: &mut [History],
-        out: PairSlices<'_>,
+        out: &mut [PairOut],
         touch: &mut [u8],
     ) {
         if self.gamma {
@@ -77,12 +77,11 @@ impl LinearPair {
         cst: &[CircleState],
         pairs: &[[u32; 2]],
         hist: &mut [History],
-        out: PairSlices<'_>,
+        out: &mut [PairOut],
         touch: &mut [u8],
     ) {
         let n = pairs.len();
-        let PairSlices { fx, fy, ti, tj } = out;
-        let (fx, fy, ti, tj) = (&mut fx[..n], &mut fy[..n], &mut ti[..n], &mut tj[..n]);
+        let out = &mut out[..n];
         let (hist, touch) = (&mut hist[..n], &mut touch[..n]);
         let nc = cst.len();
         let mut q = 0;
@@ -100,10 +99,8 @@ impl LinearPair {
                 let (hx, hy, keep) = hist_load(h);
                 let r = self.lanes::<GAMMA>(&ci, &cj, hx, hy);
                 hist_store(h, r.xix, r.xiy, keep, r.touch);
-                fx[q..q + W].copy_from_slice(&r.fx.0);
-                fy[q..q + W].copy_from_slice(&r.fy.0);
-                ti[q..q + W].copy_from_slice(&r.ti.0);
-                tj[q..q + W].copy_from_slice(&r.tj.0);
+                let o: &mut [PairOut; W] = (&mut out[q..q + W]).try_into().expect("eight records");
+                store4(o, [r.fx, r.fy, r.ti, r.tj]);
                 for k in 0..W {
                     touch[q + k] = (r.touch.0[k] & 1) as u8;
                 }
@@ -119,8 +116,12 @@ impl LinearPair {
                     h.theta_r = if t { h.theta_r } else { 0.0 };
                     h.delta_p = if t { h.delta_p } else { 0.0 };
                     touch[q + k] = u8::from(t);
-                    (fx[q + k], fy[q + k], ti[q + k], tj[q + k]) =
-                        (r.fx.0[k], r.fy.0[k], r.ti.0[k], r.tj.0[k]);
+                    out[q + k] = PairOut {
+                        fx: r.fx.0[k],
+                        fy: r.fy.0[k],
+                        ti: r.ti.0[k],
+                        tj: r.tj.0[k],
+                    };
                 }
             }
             q += m;
@@ -208,14 +209,6 @@ impl LinearPair {
 /// Lanes per batch (eight f64 = one AVX-512 register).
 const W: usize = 8;
 
-/// The per-pair result arrays (structure of arrays: whole lanes are stored at once).
-pub(crate) struct PairSlices<'a> {
-    pub fx: &'a mut [f64],
-    pub fy: &'a mut [f64],
-    pub ti: &'a mut [f64],
-    pub tj: &'a mut [f64],
-}
-
 struct LaneOut {
     touch: M8,
     xix: F8,
@@ -299,7 +292,11 @@ fn hist_store(h: &mut [History; W], xix: F8, xiy: F8, other: [F8; 2], touch: M8)
     let (t, p) = (touch.select(other[0], zero), touch.select(other[1], zero));
     #[cfg(target_feature = "avx512f")]
     {
-        x86::hist_store(h, xix, xiy, t, p);
+        // SAFETY: History is repr(C): four f64, 32 bytes.
+        x86::store4(
+            unsafe { &mut *h.as_mut_ptr().cast::<[[f64; 4]; W]>() },
+            [xix, xiy, t, p],
+        );
     }
     #[cfg(not(target_feature = "avx512f"))]
     for k in 0..W {
@@ -307,6 +304,25 @@ fn hist_store(h: &mut [History; W], xix: F8, xiy: F8, other: [F8; 2], touch: M8)
             xi_t: crate::Vec2::new(xix.0[k], xiy.0[k]),
             theta_r: t.0[k],
             delta_p: p.0[k],
+        };
+    }
+}
+
+/// Store eight pair results (lanes to records).
+#[inline(always)]
+fn store4(o: &mut [PairOut; W], v: [F8; 4]) {
+    #[cfg(target_feature = "avx512f")]
+    {
+        // SAFETY: PairOut is repr(C): four f64, 32 bytes.
+        x86::store4(unsafe { &mut *o.as_mut_ptr().cast::<[[f64; 4]; W]>() }, v);
+    }
+    #[cfg(not(target_feature = "avx512f"))]
+    for k in 0..W {
+        o[k] = PairOut {
+            fx: v[0].0[k],
+            fy: v[1].0[k],
+            ti: v[2].0[k],
+            tj: v[3].0[k],
         };
     }
 }
@@ -401,11 +417,11 @@ mod x86 {
         }
     }
 
-    /// Inverse of [`hist_load`].
+    /// Eight records of four f64 from four lane vectors (the inverse of [`hist_load`]).
     #[inline(always)]
-    pub(super) fn hist_store(h: &mut [History; W], x: F8, y: F8, t: F8, dp: F8) {
-        let (x, y, t, dp) = (m512(x), m512(y), m512(t), m512(dp));
-        // SAFETY: avx512f enabled for the build; writes the 32 f64 of eight repr(C) Histories.
+    pub(super) fn store4(h: &mut [[f64; 4]; W], v: [F8; 4]) {
+        let [x, y, t, dp] = v.map(m512);
+        // SAFETY: avx512f enabled for the build; writes the 32 f64 of `h`.
         unsafe {
             let idx = [
                 _mm512_setr_epi64(0, 4, 8, 12, 1, 5, 9, 13),

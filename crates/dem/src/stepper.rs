@@ -13,7 +13,7 @@ use crate::contact::{ContactInput, ContactLaw, History, Law, LinearSpringDashpot
 use crate::domain::Domain;
 use crate::error::DemError;
 use crate::neighbor::{CellList, carry_history};
-use crate::pair_linear::{LinearPair, PairSlices};
+use crate::pair_linear::LinearPair;
 use crate::system::System;
 use crate::vector::{Vec2, Vector};
 use crate::wall::update_wall_velocities;
@@ -56,6 +56,17 @@ impl StepParams {
     }
 }
 
+/// Result of pair (i, j): force on i (j receives −f), torques on i and j; zero when the pair
+/// does not touch. One 32-byte record: the reaction gather reads one cache line per pair.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(32))]
+pub(crate) struct PairOut {
+    pub fx: f64,
+    pub fy: f64,
+    pub ti: f64,
+    pub tj: f64,
+}
+
 /// Pairs per parallel task of the pair pass (any value gives the same bits).
 const PAIR_CHUNK: usize = 2048;
 
@@ -96,10 +107,7 @@ pub struct Stepper {
     pair_start: Vec<u32>,
     /// Result of every pair (force on i, torques on i and j; zero when not touching) and
     /// whether it touches (1) or not (0).
-    out_fx: Vec<f64>,
-    out_fy: Vec<f64>,
-    out_ti: Vec<f64>,
-    out_tj: Vec<f64>,
+    out: Vec<PairOut>,
     touch: Vec<u8>,
     /// Per circle: the pairs in which it is j, ascending i (indices into `out_j`).
     j_start: Vec<u32>,
@@ -359,14 +367,7 @@ impl Stepper {
             self.j_list[fill[c] as usize] = k as u32;
             fill[c] += 1;
         }
-        for v in [
-            &mut self.out_fx,
-            &mut self.out_fy,
-            &mut self.out_ti,
-            &mut self.out_tj,
-        ] {
-            v.resize(pairs.len(), 0.0);
-        }
+        self.out.resize(pairs.len(), PairOut::default());
         self.touch.resize(pairs.len(), 0);
         self.rebuilds += 1;
         Ok(())
@@ -388,22 +389,10 @@ impl Stepper {
                 .par_chunks(ch)
                 .zip(hist.par_chunks_mut(ch))
                 .zip(self.touch[..n].par_chunks_mut(ch))
-                .zip(
-                    self.out_fx[..n]
-                        .par_chunks_mut(ch)
-                        .zip(self.out_fy[..n].par_chunks_mut(ch)),
-                )
-                .zip(
-                    self.out_ti[..n]
-                        .par_chunks_mut(ch)
-                        .zip(self.out_tj[..n].par_chunks_mut(ch)),
-                )
-                .for_each(|((((pairs, hist), touch), (fx, fy)), (ti, tj))| {
-                    let out = PairSlices { fx, fy, ti, tj };
-                    match &fast {
-                        Some(k) => k.run(cst, pairs, hist, out, touch),
-                        None => generic_pairs(law, &dom, dt, cst, pairs, hist, out, touch),
-                    }
+                .zip(self.out[..n].par_chunks_mut(ch))
+                .for_each(|(((pairs, hist), touch), out)| match &fast {
+                    Some(k) => k.run(cst, pairs, hist, out, touch),
+                    None => generic_pairs(law, &dom, dt, cst, pairs, hist, out, touch),
                 });
         }
         // 2. Per body: each circle's own sum plus its reactions in ascending i. Without walls,
@@ -417,21 +406,20 @@ impl Stepper {
             h,
         };
         let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
-        let (ofx, ofy, oti, otj) = (&self.out_fx, &self.out_fy, &self.out_ti, &self.out_tj);
-        let (ps, js, jl) = (&self.pair_start, &self.j_start, &self.j_list);
+        let (out, ps, js, jl) = (&self.out, &self.pair_start, &self.j_start, &self.j_list);
         // Circle c: its pairs as i in ascending j, then as j in ascending i (the reaction −f).
         let circle_sum = |c: usize| -> (Vec2, f64) {
             let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
-            for q in ps[c] as usize..ps[c + 1] as usize {
-                fc.x += ofx[q];
-                fc.y += ofy[q];
-                tc += oti[q];
+            for o in &out[ps[c] as usize..ps[c + 1] as usize] {
+                fc.x += o.fx;
+                fc.y += o.fy;
+                tc += o.ti;
             }
             for &q in &jl[js[c] as usize..js[c + 1] as usize] {
-                let q = q as usize;
-                fc.x -= ofx[q];
-                fc.y -= ofy[q];
-                tc += otj[q];
+                let o = &out[q as usize];
+                fc.x -= o.fx;
+                fc.y -= o.fy;
+                tc += o.tj;
             }
             (fc, tc)
         };
@@ -605,10 +593,10 @@ fn generic_pairs<L: ContactLaw>(
     cst: &[CircleState],
     pairs: &[[u32; 2]],
     hist: &mut [History],
-    out: PairSlices<'_>,
+    out: &mut [PairOut],
     touch: &mut [u8],
 ) {
-    for (q, ((pr, h), t)) in pairs.iter().zip(hist).zip(touch).enumerate() {
+    for (((pr, h), t), o) in pairs.iter().zip(hist).zip(touch).zip(out) {
         let (ci, cj) = (&cst[pr[0] as usize], &cst[pr[1] as usize]);
         let d = dom.min_image(cj.pos - ci.pos);
         let (ri, rj) = (ci.r, cj.r);
@@ -618,7 +606,7 @@ fn generic_pairs<L: ContactLaw>(
             if *h != History::default() {
                 *h = History::default();
             }
-            (out.fx[q], out.fy[q], out.ti[q], out.tj[q]) = (0.0, 0.0, 0.0, 0.0);
+            *o = PairOut::default();
             *t = 0;
             continue;
         }
@@ -641,10 +629,12 @@ fn generic_pairs<L: ContactLaw>(
         };
         let r = law.force(&c, h);
         let nxf = n.cross(r.f);
-        out.fx[q] = r.f.x;
-        out.fy[q] = r.f.y;
-        out.ti[q] = ai * nxf + r.m_roll;
-        out.tj[q] = aj * nxf - r.m_roll;
+        *o = PairOut {
+            fx: r.f.x,
+            fy: r.f.y,
+            ti: ai * nxf + r.m_roll,
+            tj: aj * nxf - r.m_roll,
+        };
         *t = 1;
     }
 }
