@@ -67,8 +67,37 @@ pub(crate) struct PairOut {
     pub tj: f64,
 }
 
+/// Per body: h/m and h/I of the half kicks, kept while h, m and I stay the same (divisions are
+/// the dearest part of the per-body passes).
+#[derive(Clone, Copy, Debug, Default)]
+struct Kick {
+    h: f64,
+    m: f64,
+    i: f64,
+    hm: f64,
+    hi: f64,
+}
+
+impl Kick {
+    #[inline(always)]
+    fn refresh(&mut self, h: f64, m: f64, i: f64) {
+        if self.h != h || self.m != m || self.i != i {
+            *self = Kick {
+                h,
+                m,
+                i,
+                hm: h / m,
+                hi: h / i,
+            };
+        }
+    }
+}
+
+/// Bodies per parallel task of the per-body passes (any value gives the same bits).
+const BODY_CHUNK: usize = 512;
+
 /// Pairs per parallel task of the pair pass (any value gives the same bits).
-const PAIR_CHUNK: usize = 2048;
+const PAIR_CHUNK: usize = 1024;
 
 /// What the pair loop reads of a circle, packed in one cache line.
 #[derive(Clone, Copy, Debug, Default)]
@@ -115,6 +144,7 @@ pub struct Stepper {
     /// Every body is a single circle at its centre (circle c = body c): fused fast paths.
     all_disks: bool,
     wall_buf: Vec<(Vec2, f64)>,
+    kick: Vec<Kick>,
     n_circles: usize,
     n_bodies: usize,
     checked_dt: f64,
@@ -177,6 +207,7 @@ impl Stepper {
     ) -> Result<(), DemError> {
         let dt = p.dt;
         let shape = (sys.bodies.n_circles(), sys.bodies.len());
+        self.kick.resize(sys.bodies.len(), Kick::default());
         if self.checked_dt != dt || (self.n_circles, self.n_bodies) != shape {
             let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
             if dt.is_nan() || dt <= 0.0 || dt > crit {
@@ -240,33 +271,48 @@ impl Stepper {
         self.carm.resize(nc, Vec2::ZERO);
         self.cstate.resize(nc, CircleState::default());
         let refp = &self.ref_pos;
+        let ch = BODY_CHUNK;
         b.pos
-            .par_iter_mut()
-            .zip(b.vel.par_iter_mut())
-            .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
-            .zip(self.cstate.par_iter_mut())
+            .par_chunks_mut(ch)
+            .zip(b.vel.par_chunks_mut(ch))
+            .zip(b.angle.par_chunks_mut(ch).zip(b.omega.par_chunks_mut(ch)))
+            .zip(self.cstate.par_chunks_mut(ch).zip(self.kick.par_chunks_mut(ch)))
             .enumerate()
-            .with_min_len(2048)
-            .map(|(k, (((x, v), (a, w)), st))| {
-                *v += force[k] * (h / mass[k]);
-                *w += torque[k] * h / inertia[k];
-                *x = dom.wrap(*x + *v * dt);
-                *a += *w * dt;
-                *st = CircleState {
-                    pos: *x,
-                    vel: *v,
-                    omega: *w,
-                    r: rad[k],
-                    mass: mass[k],
-                    pad: 0.0,
-                };
-                dom.min_image(*x - refp[k]).norm2()
+            .map(|(c, (((x, v), (a, w)), (st, kc)))| {
+                let r = c * ch..c * ch + x.len();
+                let (f, t, m, i, rad, refp) = (
+                    &force[r.clone()],
+                    &torque[r.clone()],
+                    &mass[r.clone()],
+                    &inertia[r.clone()],
+                    &rad[r.clone()],
+                    &refp[r],
+                );
+                let mut worst = 0.0;
+                for l in 0..x.len() {
+                    let kk = &mut kc[l];
+                    kk.refresh(h, m[l], i[l]);
+                    v[l] += f[l] * kk.hm;
+                    w[l] += t[l] * kk.hi;
+                    x[l] = dom.wrap(x[l] + v[l] * dt);
+                    a[l] += w[l] * dt;
+                    st[l] = CircleState {
+                        pos: x[l],
+                        vel: v[l],
+                        omega: w[l],
+                        r: rad[l],
+                        mass: m[l],
+                        pad: 0.0,
+                    };
+                    worst = nan_max(worst, dom.min_image(x[l] - refp[l]).norm2());
+                }
+                worst
             })
             .reduce(|| 0.0, nan_max)
     }
 
     /// Half kick then drift, fused in one pass over the bodies.
-    fn kick_drift(&self, sys: &mut System, h: f64, dt: f64) {
+    fn kick_drift(&mut self, sys: &mut System, h: f64, dt: f64) {
         let dom = sys.domain;
         let b = &mut sys.bodies;
         let (force, mass, torque, inertia) = (&b.force, &b.mass, &b.torque, &b.inertia);
@@ -274,11 +320,13 @@ impl Stepper {
             .par_iter_mut()
             .zip(b.vel.par_iter_mut())
             .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
+            .zip(self.kick.par_iter_mut())
             .enumerate()
             .with_min_len(4096)
-            .for_each(|(k, ((x, v), (a, w)))| {
-                *v += force[k] * (h / mass[k]);
-                *w += torque[k] * h / inertia[k];
+            .for_each(|(k, (((x, v), (a, w)), kk))| {
+                kk.refresh(h, mass[k], inertia[k]);
+                *v += force[k] * kk.hm;
+                *w += torque[k] * kk.hi;
                 *x = dom.wrap(*x + *v * dt);
                 *a += *w * dt;
             });
@@ -424,6 +472,7 @@ impl Stepper {
             (fc, tc)
         };
         let disks = self.all_disks;
+        let kick = &self.kick;
         let bodies = &mut sys.bodies;
         let Bodies5 {
             force,
@@ -441,7 +490,7 @@ impl Stepper {
             .zip(torque.par_iter_mut())
             .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
             .enumerate()
-            .with_min_len(1024)
+            .with_min_len(512)
             .for_each(|(k, ((f, t), (v, w)))| {
                 if disks {
                     (*f, *t) = circle_sum(k);
@@ -457,7 +506,17 @@ impl Stepper {
                     *t = tb;
                 }
                 if simple {
-                    fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
+                    fin.apply(
+                        f,
+                        t,
+                        v,
+                        w,
+                        mass[k],
+                        inertia[k],
+                        &kick[k],
+                        ext_force[k],
+                        ext_torque[k],
+                    );
                 }
             });
         if simple {
@@ -553,6 +612,7 @@ impl Stepper {
             }
         }
         // 5. Body forces, drivers, damping.
+        let kick = &self.kick;
         let bodies = &mut sys.bodies;
         if let Some(mem) = &sys.membrane {
             for (k, &bk) in mem.bodies.iter().enumerate() {
@@ -579,7 +639,17 @@ impl Stepper {
             .enumerate()
             .with_min_len(1024)
             .for_each(|(k, ((f, t), (v, w)))| {
-                fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
+                fin.apply(
+                    f,
+                    t,
+                    v,
+                    w,
+                    mass[k],
+                    inertia[k],
+                    &kick[k],
+                    ext_force[k],
+                    ext_torque[k],
+                );
             });
     }
 }
@@ -650,7 +720,18 @@ struct Finish {
 impl Finish {
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn apply(&self, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64, m: f64, i: f64, ef: Vec2, et: f64) {
+    fn apply(
+        &self,
+        f: &mut Vec2,
+        t: &mut f64,
+        v: &mut Vec2,
+        w: &mut f64,
+        m: f64,
+        i: f64,
+        kick: &Kick,
+        ef: Vec2,
+        et: f64,
+    ) {
         *f += self.g * m + ef;
         *t += et;
         if self.gv > 0.0 {
@@ -663,8 +744,9 @@ impl Finish {
             *t -= self.al * t.abs() * sign(*w);
         }
         if self.h != 0.0 {
-            *v += *f * (self.h / m);
-            *w += *t * self.h / i;
+            // The opening kick of this step refreshed `kick` for this h.
+            *v += *f * kick.hm;
+            *w += *t * kick.hi;
         }
     }
 }
