@@ -96,6 +96,10 @@ impl Kick {
 /// Bodies per parallel task of the per-body passes (any value gives the same bits).
 const BODY_CHUNK: usize = 512;
 
+/// Circles per task of the fused pair + per-body pass of disk systems (any value gives the
+/// same bits).
+const CIRCLE_CHUNK: usize = 1024;
+
 /// Pairs per parallel task of the pair pass (any value gives the same bits).
 const PAIR_CHUNK: usize = 1024;
 
@@ -141,6 +145,10 @@ pub struct Stepper {
     /// Per circle: the pairs in which it is j, ascending i (indices into `out_j`).
     j_start: Vec<u32>,
     j_list: Vec<u32>,
+    /// Circles (ascending) with a reaction from a lower chunk of `CIRCLE_CHUNK` circles, and
+    /// where each chunk's start in that list (the fused disk pass finishes them last).
+    deferred: Vec<u32>,
+    deferred_start: Vec<u32>,
     /// Every body is a single circle at its centre (circle c = body c): fused fast paths.
     all_disks: bool,
     wall_buf: Vec<(Vec2, f64)>,
@@ -417,6 +425,19 @@ impl Stepper {
         }
         self.out.resize(pairs.len(), PairOut::default());
         self.touch.resize(pairs.len(), 0);
+        // Circles whose lowest partner i lies in an earlier chunk than their own.
+        self.deferred.clear();
+        self.deferred_start.clear();
+        for c0 in (0..nc).step_by(CIRCLE_CHUNK) {
+            self.deferred_start.push(self.deferred.len() as u32);
+            for c in c0..(c0 + CIRCLE_CHUNK).min(nc) {
+                let (a, b) = (self.j_start[c] as usize, self.j_start[c + 1] as usize);
+                if a < b && (pairs[self.j_list[a] as usize][0] as usize) < c0 {
+                    self.deferred.push(c as u32);
+                }
+            }
+        }
+        self.deferred_start.push(self.deferred.len() as u32);
         self.rebuilds += 1;
         Ok(())
     }
@@ -425,6 +446,11 @@ impl Stepper {
     fn forces<L: ContactLaw>(&mut self, p: &StepParams, law: &L, wall_law: &L, sys: &mut System, h: f64) {
         let dt = p.dt;
         let dom = sys.domain;
+        let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
+        if self.all_disks && simple {
+            self.forces_disks(p, law, sys, h);
+            return;
+        }
         let (carm, cst) = (&self.carm, &self.cstate);
         // 1. Every pair, in parallel over fixed chunks of pairs: force on i, torques on i and j.
         {
@@ -453,7 +479,6 @@ impl Stepper {
             al: p.local_damping,
             h,
         };
-        let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
         let (out, ps, js, jl) = (&self.out, &self.pair_start, &self.j_start, &self.j_list);
         // Circle c: its pairs as i in ascending j, then as j in ascending i (the reaction −f).
         let circle_sum = |c: usize| -> (Vec2, f64) {
@@ -650,6 +675,113 @@ impl Stepper {
                     ext_force[k],
                     ext_torque[k],
                 );
+            });
+    }
+}
+
+impl Stepper {
+    /// Disks without walls, bonds or membrane: the pair pass and the per-body pass fused per
+    /// chunk of circles, so each chunk's pair results are summed while still in cache. Circle
+    /// c needs the reactions of all its partners i < c; those in the chunk are done before
+    /// it, so every circle without a partner in an earlier chunk is finished in the same task
+    /// (same summation order as the separate passes, hence the same bits); the rest
+    /// (`deferred`) follow in a second pass.
+    fn forces_disks<L: ContactLaw>(&mut self, p: &StepParams, law: &L, sys: &mut System, h: f64) {
+        let (dt, dom) = (p.dt, sys.domain);
+        let fin = Finish {
+            g: p.gravity * p.gravity_factor,
+            gv: p.viscous_damping,
+            al: p.local_damping,
+            h,
+        };
+        let fast = law.linear().and_then(|l| LinearPair::new(l, &dom, dt));
+        let (cst, ps, js, jl, kick) = (&self.cstate, &self.pair_start, &self.j_start, &self.j_list, &self.kick);
+        let (deferred, dstart) = (&self.deferred, &self.deferred_start);
+        let pairs = &sys.contacts.pairs;
+        let Bodies5 {
+            force,
+            torque,
+            vel,
+            omega,
+            mass,
+            inertia,
+            ext_force,
+            ext_torque,
+            ..
+        } = Bodies5::of(&mut sys.bodies);
+        let nc = force.len();
+        // Sum of circle c and its finish; `out` holds the pairs from `base` on.
+        let finish = |c: usize, out: &[PairOut], base: usize, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64| {
+            let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
+            for o in &out[ps[c] as usize - base..ps[c + 1] as usize - base] {
+                fc.x += o.fx;
+                fc.y += o.fy;
+                tc += o.ti;
+            }
+            for &q in &jl[js[c] as usize..js[c + 1] as usize] {
+                let o = &out[q as usize - base];
+                fc.x -= o.fx;
+                fc.y -= o.fy;
+                tc += o.tj;
+            }
+            (*f, *t) = (fc, tc);
+            fin.apply(f, t, v, w, mass[c], inertia[c], &kick[c], ext_force[c], ext_torque[c]);
+        };
+        {
+            let mut tasks = Vec::with_capacity(nc.div_ceil(CIRCLE_CHUNK));
+            let (mut hist, mut out, mut touch) = (
+                &mut sys.contacts.hist[..],
+                &mut self.out[..],
+                &mut self.touch[..],
+            );
+            let body = force
+                .chunks_mut(CIRCLE_CHUNK)
+                .zip(torque.chunks_mut(CIRCLE_CHUNK))
+                .zip(vel.chunks_mut(CIRCLE_CHUNK).zip(omega.chunks_mut(CIRCLE_CHUNK)));
+            for (k, bk) in body.enumerate() {
+                let c0 = k * CIRCLE_CHUNK;
+                let c1 = (c0 + CIRCLE_CHUNK).min(nc);
+                let len = (ps[c1] - ps[c0]) as usize;
+                let (hk, hr) = std::mem::take(&mut hist).split_at_mut(len);
+                let (ok, or) = std::mem::take(&mut out).split_at_mut(len);
+                let (tk, tr) = std::mem::take(&mut touch).split_at_mut(len);
+                (hist, out, touch) = (hr, or, tr);
+                tasks.push((k, hk, ok, tk, bk));
+            }
+            tasks
+                .into_par_iter()
+                .for_each(|(k, hist, out, touch, ((f, t), (v, w)))| {
+                    let c0 = k * CIRCLE_CHUNK;
+                    let base = ps[c0] as usize;
+                    let pr = &pairs[base..base + out.len()];
+                    match &fast {
+                        Some(kern) => kern.run(cst, pr, hist, out, touch),
+                        None => generic_pairs(law, &dom, dt, cst, pr, hist, out, touch),
+                    }
+                    let mut skip = deferred[dstart[k] as usize..dstart[k + 1] as usize].iter().peekable();
+                    for l in 0..f.len() {
+                        let c = c0 + l;
+                        if skip.peek().is_some_and(|&&d| d as usize == c) {
+                            skip.next();
+                            continue;
+                        }
+                        finish(c, out, base, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
+                    }
+                });
+        }
+        // Circles with a partner in an earlier chunk, now that every pair is done.
+        let out = &self.out[..];
+        force
+            .par_chunks_mut(CIRCLE_CHUNK)
+            .zip(torque.par_chunks_mut(CIRCLE_CHUNK))
+            .zip(vel.par_chunks_mut(CIRCLE_CHUNK).zip(omega.par_chunks_mut(CIRCLE_CHUNK)))
+            .enumerate()
+            .for_each(|(k, ((f, t), (v, w)))| {
+                let c0 = k * CIRCLE_CHUNK;
+                for &c in &deferred[dstart[k] as usize..dstart[k + 1] as usize] {
+                    let l = c as usize - c0;
+                    finish(c as usize, out, 0, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
+                }
             });
     }
 }
