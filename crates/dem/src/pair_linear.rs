@@ -6,6 +6,7 @@
 
 use crate::contact::{Damping, History, LinearSpringDashpot};
 use crate::domain::Domain;
+use crate::lanes::{F8, M8, W};
 use crate::stepper::{CircleState, PairOut};
 
 /// The law and box constants of one force evaluation.
@@ -102,25 +103,26 @@ impl LinearPair {
                 let o: &mut [PairOut; W] = (&mut out[q..q + W]).try_into().expect("eight records");
                 store4(o, [r.fx, r.fy, r.ti, r.tj]);
                 for k in 0..W {
-                    touch[q + k] = (r.touch.0[k] & 1) as u8;
+                    touch[q + k] = u8::from(r.touch.bit(k));
                 }
             } else {
-                let hx = F8(std::array::from_fn(|k| hist[lane(k)].xi_t.x));
-                let hy = F8(std::array::from_fn(|k| hist[lane(k)].xi_t.y));
+                let hx = F8::from_array(std::array::from_fn(|k| hist[lane(k)].xi_t.x));
+                let hy = F8::from_array(std::array::from_fn(|k| hist[lane(k)].xi_t.y));
                 let r = self.lanes::<GAMMA>(&ci, &cj, hx, hy);
+                let [xix, xiy, fx, fy, ti, tj] = [r.xix, r.xiy, r.fx, r.fy, r.ti, r.tj].map(F8::to_array);
                 for k in 0..m {
                     let h = &mut hist[q + k];
-                    let t = r.touch.0[k] != 0;
-                    h.xi_t.x = r.xix.0[k];
-                    h.xi_t.y = r.xiy.0[k];
+                    let t = r.touch.bit(k);
+                    h.xi_t.x = xix[k];
+                    h.xi_t.y = xiy[k];
                     h.theta_r = if t { h.theta_r } else { 0.0 };
                     h.delta_p = if t { h.delta_p } else { 0.0 };
                     touch[q + k] = u8::from(t);
                     out[q + k] = PairOut {
-                        fx: r.fx.0[k],
-                        fy: r.fy.0[k],
-                        ti: r.ti.0[k],
-                        tj: r.tj.0[k],
+                        fx: fx[k],
+                        fy: fy[k],
+                        ti: ti[k],
+                        tj: tj[k],
                     };
                 }
             }
@@ -206,9 +208,6 @@ impl LinearPair {
     }
 }
 
-/// Lanes per batch (eight f64 = one AVX-512 register).
-const W: usize = 8;
-
 struct LaneOut {
     touch: M8,
     xix: F8,
@@ -251,7 +250,7 @@ impl Lanes {
         #[cfg(not(target_feature = "avx512f"))]
         {
             let rows: [[f64; W]; W] = std::array::from_fn(|k| cst[idx[k]].line());
-            let col = |f: usize| F8(std::array::from_fn(|k| rows[k][f]));
+            let col = |f: usize| F8::from_array(std::array::from_fn(|k| rows[k][f]));
             Self {
                 x: col(0),
                 y: col(1),
@@ -275,11 +274,11 @@ fn hist_load(h: &[History; W]) -> (F8, F8, [F8; 2]) {
     #[cfg(not(target_feature = "avx512f"))]
     {
         (
-            F8(std::array::from_fn(|k| h[k].xi_t.x)),
-            F8(std::array::from_fn(|k| h[k].xi_t.y)),
+            F8::from_array(std::array::from_fn(|k| h[k].xi_t.x)),
+            F8::from_array(std::array::from_fn(|k| h[k].xi_t.y)),
             [
-                F8(std::array::from_fn(|k| h[k].theta_r)),
-                F8(std::array::from_fn(|k| h[k].delta_p)),
+                F8::from_array(std::array::from_fn(|k| h[k].theta_r)),
+                F8::from_array(std::array::from_fn(|k| h[k].delta_p)),
             ],
         )
     }
@@ -299,12 +298,15 @@ fn hist_store(h: &mut [History; W], xix: F8, xiy: F8, other: [F8; 2], touch: M8)
         );
     }
     #[cfg(not(target_feature = "avx512f"))]
-    for k in 0..W {
-        h[k] = History {
-            xi_t: crate::Vec2::new(xix.0[k], xiy.0[k]),
-            theta_r: t.0[k],
-            delta_p: p.0[k],
-        };
+    {
+        let [xix, xiy, t, p] = [xix, xiy, t, p].map(F8::to_array);
+        for k in 0..W {
+            h[k] = History {
+                xi_t: crate::Vec2::new(xix[k], xiy[k]),
+                theta_r: t[k],
+                delta_p: p[k],
+            };
+        }
     }
 }
 
@@ -317,13 +319,16 @@ fn store4(o: &mut [PairOut; W], v: [F8; 4]) {
         x86::store4(unsafe { &mut *o.as_mut_ptr().cast::<[[f64; 4]; W]>() }, v);
     }
     #[cfg(not(target_feature = "avx512f"))]
-    for k in 0..W {
-        o[k] = PairOut {
-            fx: v[0].0[k],
-            fy: v[1].0[k],
-            ti: v[2].0[k],
-            tj: v[3].0[k],
-        };
+    {
+        let v = v.map(F8::to_array);
+        for k in 0..W {
+            o[k] = PairOut {
+                fx: v[0][k],
+                fy: v[1][k],
+                ti: v[2][k],
+                tj: v[3][k],
+            };
+        }
     }
 }
 
@@ -338,13 +343,11 @@ mod x86 {
 
     #[inline(always)]
     fn f8(v: __m512d) -> F8 {
-        // SAFETY: F8 is 64 bytes, 64-byte aligned, plain f64s.
-        unsafe { std::mem::transmute::<__m512d, F8>(v) }
+        F8(v)
     }
     #[inline(always)]
     fn m512(v: F8) -> __m512d {
-        // SAFETY: as above.
-        unsafe { std::mem::transmute::<F8, __m512d>(v) }
+        v.0
     }
 
     /// Columns 0..7 of the eight lines `cst[idx[k]]`.
@@ -446,83 +449,5 @@ mod x86 {
                 _mm512_storeu_pd(p.add(8 * k), v);
             }
         }
-    }
-}
-
-/// Eight f64 lanes; every operation is the scalar IEEE operation per lane (no fused
-/// multiply-add), so a lane's bits equal the scalar code's.
-#[derive(Clone, Copy)]
-#[repr(C, align(64))]
-struct F8([f64; W]);
-
-/// Lane mask: all ones (true) or zero.
-#[derive(Clone, Copy)]
-#[repr(C, align(64))]
-struct M8([u64; W]);
-
-macro_rules! lanewise {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl std::ops::$tr for F8 {
-            type Output = F8;
-            #[inline(always)]
-            fn $f(self, o: F8) -> F8 {
-                F8(std::array::from_fn(|k| self.0[k] $op o.0[k]))
-            }
-        }
-    };
-}
-lanewise!(Add, add, +);
-lanewise!(Sub, sub, -);
-lanewise!(Mul, mul, *);
-lanewise!(Div, div, /);
-
-impl std::ops::Neg for F8 {
-    type Output = F8;
-    #[inline(always)]
-    fn neg(self) -> F8 {
-        F8(self.0.map(|v| -v))
-    }
-}
-
-impl F8 {
-    #[inline(always)]
-    fn splat(v: f64) -> F8 {
-        F8([v; W])
-    }
-    #[inline(always)]
-    fn sqrt(self) -> F8 {
-        F8(self.0.map(f64::sqrt))
-    }
-    #[inline(always)]
-    fn abs(self) -> F8 {
-        F8(self.0.map(f64::abs))
-    }
-    /// `f64::max(self, 0.0)` per lane.
-    #[inline(always)]
-    fn max0(self) -> F8 {
-        F8(self.0.map(|v| v.max(0.0)))
-    }
-    /// Magnitude of self with the sign of `s`.
-    #[inline(always)]
-    fn copysign(self, s: F8) -> F8 {
-        F8(std::array::from_fn(|k| self.0[k].copysign(s.0[k])))
-    }
-    #[inline(always)]
-    fn lt(self, o: F8) -> M8 {
-        M8(std::array::from_fn(|k| if self.0[k] < o.0[k] { !0 } else { 0 }))
-    }
-    #[inline(always)]
-    fn gt(self, o: F8) -> M8 {
-        M8(std::array::from_fn(|k| if self.0[k] > o.0[k] { !0 } else { 0 }))
-    }
-}
-
-impl M8 {
-    /// `a` where the mask is set, else `b`.
-    #[inline(always)]
-    fn select(self, a: F8, b: F8) -> F8 {
-        F8(std::array::from_fn(|k| {
-            f64::from_bits((a.0[k].to_bits() & self.0[k]) | (b.0[k].to_bits() & !self.0[k]))
-        }))
     }
 }

@@ -695,7 +695,13 @@ impl Stepper {
             h,
         };
         let fast = law.linear().and_then(|l| LinearPair::new(l, &dom, dt));
-        let (cst, ps, js, jl, kick) = (&self.cstate, &self.pair_start, &self.j_start, &self.j_list, &self.kick);
+        let (cst, ps, js, jl, kick) = (
+            &self.cstate,
+            &self.pair_start,
+            &self.j_start,
+            &self.j_list,
+            &self.kick,
+        );
         let (deferred, dstart) = (&self.deferred, &self.deferred_start);
         let pairs = &sys.contacts.pairs;
         let Bodies5 {
@@ -711,29 +717,37 @@ impl Stepper {
         } = Bodies5::of(&mut sys.bodies);
         let nc = force.len();
         // Sum of circle c and its finish; `out` holds the pairs from `base` on.
-        let finish = |c: usize, out: &[PairOut], base: usize, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64| {
-            let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
-            for o in &out[ps[c] as usize - base..ps[c + 1] as usize - base] {
-                fc.x += o.fx;
-                fc.y += o.fy;
-                tc += o.ti;
-            }
-            for &q in &jl[js[c] as usize..js[c + 1] as usize] {
-                let o = &out[q as usize - base];
-                fc.x -= o.fx;
-                fc.y -= o.fy;
-                tc += o.tj;
-            }
-            (*f, *t) = (fc, tc);
-            fin.apply(f, t, v, w, mass[c], inertia[c], &kick[c], ext_force[c], ext_torque[c]);
-        };
+        let finish =
+            |c: usize, out: &[PairOut], base: usize, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64| {
+                let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
+                for o in &out[ps[c] as usize - base..ps[c + 1] as usize - base] {
+                    fc.x += o.fx;
+                    fc.y += o.fy;
+                    tc += o.ti;
+                }
+                for &q in &jl[js[c] as usize..js[c + 1] as usize] {
+                    let o = &out[q as usize - base];
+                    fc.x -= o.fx;
+                    fc.y -= o.fy;
+                    tc += o.tj;
+                }
+                (*f, *t) = (fc, tc);
+                fin.apply(
+                    f,
+                    t,
+                    v,
+                    w,
+                    mass[c],
+                    inertia[c],
+                    &kick[c],
+                    ext_force[c],
+                    ext_torque[c],
+                );
+            };
         {
             let mut tasks = Vec::with_capacity(nc.div_ceil(CIRCLE_CHUNK));
-            let (mut hist, mut out, mut touch) = (
-                &mut sys.contacts.hist[..],
-                &mut self.out[..],
-                &mut self.touch[..],
-            );
+            let (mut hist, mut out, mut touch) =
+                (&mut sys.contacts.hist[..], &mut self.out[..], &mut self.touch[..]);
             let body = force
                 .chunks_mut(CIRCLE_CHUNK)
                 .zip(torque.chunks_mut(CIRCLE_CHUNK))
@@ -758,7 +772,9 @@ impl Stepper {
                         Some(kern) => kern.run(cst, pr, hist, out, touch),
                         None => generic_pairs(law, &dom, dt, cst, pr, hist, out, touch),
                     }
-                    let mut skip = deferred[dstart[k] as usize..dstart[k + 1] as usize].iter().peekable();
+                    let mut skip = deferred[dstart[k] as usize..dstart[k + 1] as usize]
+                        .iter()
+                        .peekable();
                     for l in 0..f.len() {
                         let c = c0 + l;
                         if skip.peek().is_some_and(|&&d| d as usize == c) {
@@ -774,7 +790,10 @@ impl Stepper {
         force
             .par_chunks_mut(CIRCLE_CHUNK)
             .zip(torque.par_chunks_mut(CIRCLE_CHUNK))
-            .zip(vel.par_chunks_mut(CIRCLE_CHUNK).zip(omega.par_chunks_mut(CIRCLE_CHUNK)))
+            .zip(
+                vel.par_chunks_mut(CIRCLE_CHUNK)
+                    .zip(omega.par_chunks_mut(CIRCLE_CHUNK)),
+            )
             .enumerate()
             .for_each(|(k, ((f, t), (v, w)))| {
                 let c0 = k * CIRCLE_CHUNK;
