@@ -93,6 +93,84 @@ mod imp {
         pub(crate) fn gt(self, o: F8) -> M8 {
             M8(unsafe { _mm512_cmp_pd_mask::<_CMP_GT_OQ>(self.0, o.0) })
         }
+        #[inline(always)]
+        pub(crate) fn ge(self, o: F8) -> M8 {
+            M8(unsafe { _mm512_cmp_pd_mask::<_CMP_GE_OQ>(self.0, o.0) })
+        }
+        /// Lanes that are not in [lo, hi) (NaN included).
+        #[inline(always)]
+        pub(crate) fn outside(self, lo: F8, hi: F8) -> M8 {
+            M8(unsafe {
+                _mm512_cmp_pd_mask::<_CMP_NGE_UQ>(self.0, lo.0)
+                    | _mm512_cmp_pd_mask::<_CMP_NLT_UQ>(self.0, hi.0)
+            })
+        }
+    }
+
+    /// x and y lanes of eight (x, y) pairs.
+    #[inline(always)]
+    pub(crate) fn deinterleave(p: &[[f64; 2]; W]) -> (F8, F8) {
+        unsafe {
+            let q = p.as_ptr().cast::<f64>();
+            let (a, b) = (_mm512_loadu_pd(q), _mm512_loadu_pd(q.add(8)));
+            let ix = _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14);
+            let iy = _mm512_setr_epi64(1, 3, 5, 7, 9, 11, 13, 15);
+            (
+                F8(_mm512_permutex2var_pd(a, ix, b)),
+                F8(_mm512_permutex2var_pd(a, iy, b)),
+            )
+        }
+    }
+
+    /// Inverse of [`deinterleave`].
+    #[inline(always)]
+    pub(crate) fn interleave(x: F8, y: F8, p: &mut [[f64; 2]; W]) {
+        unsafe {
+            let lo = _mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11);
+            let hi = _mm512_setr_epi64(4, 12, 5, 13, 6, 14, 7, 15);
+            let q = p.as_mut_ptr().cast::<f64>();
+            _mm512_storeu_pd(q, _mm512_permutex2var_pd(x.0, lo, y.0));
+            _mm512_storeu_pd(q.add(8), _mm512_permutex2var_pd(x.0, hi, y.0));
+        }
+    }
+
+    /// 8 x 8 transpose (lanes of column k become row k).
+    #[inline(always)]
+    pub(crate) fn transpose(r: [F8; W]) -> [[f64; W]; W] {
+        unsafe {
+            let r = r.map(|v| v.0);
+            let t = [
+                _mm512_unpacklo_pd(r[0], r[1]),
+                _mm512_unpackhi_pd(r[0], r[1]),
+                _mm512_unpacklo_pd(r[2], r[3]),
+                _mm512_unpackhi_pd(r[2], r[3]),
+                _mm512_unpacklo_pd(r[4], r[5]),
+                _mm512_unpackhi_pd(r[4], r[5]),
+                _mm512_unpacklo_pd(r[6], r[7]),
+                _mm512_unpackhi_pd(r[6], r[7]),
+            ];
+            let u = [
+                _mm512_shuffle_f64x2::<0x88>(t[0], t[2]),
+                _mm512_shuffle_f64x2::<0xDD>(t[0], t[2]),
+                _mm512_shuffle_f64x2::<0x88>(t[1], t[3]),
+                _mm512_shuffle_f64x2::<0xDD>(t[1], t[3]),
+                _mm512_shuffle_f64x2::<0x88>(t[4], t[6]),
+                _mm512_shuffle_f64x2::<0xDD>(t[4], t[6]),
+                _mm512_shuffle_f64x2::<0x88>(t[5], t[7]),
+                _mm512_shuffle_f64x2::<0xDD>(t[5], t[7]),
+            ];
+            let c = [
+                _mm512_shuffle_f64x2::<0x88>(u[0], u[4]),
+                _mm512_shuffle_f64x2::<0x88>(u[2], u[6]),
+                _mm512_shuffle_f64x2::<0x88>(u[1], u[5]),
+                _mm512_shuffle_f64x2::<0x88>(u[3], u[7]),
+                _mm512_shuffle_f64x2::<0xDD>(u[0], u[4]),
+                _mm512_shuffle_f64x2::<0xDD>(u[2], u[6]),
+                _mm512_shuffle_f64x2::<0xDD>(u[1], u[5]),
+                _mm512_shuffle_f64x2::<0xDD>(u[3], u[7]),
+            ];
+            c.map(|v| F8(v).to_array())
+        }
     }
 
     impl M8 {
@@ -100,6 +178,11 @@ mod imp {
         #[inline(always)]
         pub(crate) fn select(self, a: F8, b: F8) -> F8 {
             F8(unsafe { _mm512_mask_blend_pd(self.0, b.0, a.0) })
+        }
+        /// Any lane set.
+        #[inline(always)]
+        pub(crate) fn any(self) -> bool {
+            self.0 != 0
         }
         #[inline(always)]
         pub(crate) fn bit(self, k: usize) -> bool {
@@ -184,6 +267,41 @@ mod imp {
         pub(crate) fn gt(self, o: F8) -> M8 {
             M8(std::array::from_fn(|k| if self.0[k] > o.0[k] { !0 } else { 0 }))
         }
+        #[inline(always)]
+        pub(crate) fn ge(self, o: F8) -> M8 {
+            M8(std::array::from_fn(|k| if self.0[k] >= o.0[k] { !0 } else { 0 }))
+        }
+        /// Lanes that are not in [lo, hi) (NaN included).
+        #[inline(always)]
+        pub(crate) fn outside(self, lo: F8, hi: F8) -> M8 {
+            M8(std::array::from_fn(|k| {
+                if !(self.0[k] >= lo.0[k] && self.0[k] < hi.0[k]) {
+                    !0
+                } else {
+                    0
+                }
+            }))
+        }
+    }
+
+    /// x and y lanes of eight (x, y) pairs.
+    #[inline(always)]
+    pub(crate) fn deinterleave(p: &[[f64; 2]; W]) -> (F8, F8) {
+        (F8(p.map(|q| q[0])), F8(p.map(|q| q[1])))
+    }
+
+    /// Inverse of [`deinterleave`].
+    #[inline(always)]
+    pub(crate) fn interleave(x: F8, y: F8, p: &mut [[f64; 2]; W]) {
+        for k in 0..W {
+            p[k] = [x.0[k], y.0[k]];
+        }
+    }
+
+    /// 8 x 8 transpose (lanes of column k become row k).
+    #[inline(always)]
+    pub(crate) fn transpose(r: [F8; W]) -> [[f64; W]; W] {
+        std::array::from_fn(|k| std::array::from_fn(|f| r[f].0[k]))
     }
 
     impl M8 {
@@ -198,7 +316,12 @@ mod imp {
         pub(crate) fn bit(self, k: usize) -> bool {
             self.0[k] != 0
         }
+        /// Any lane set.
+        #[inline(always)]
+        pub(crate) fn any(self) -> bool {
+            self.0.iter().any(|&m| m != 0)
+        }
     }
 }
 
-pub(crate) use imp::{F8, M8};
+pub(crate) use imp::{F8, M8, deinterleave, interleave, transpose};

@@ -9,6 +9,7 @@ pub mod contact;
 pub mod domain;
 pub mod error;
 pub mod generate;
+mod kick_disks;
 mod lanes;
 pub mod neighbor;
 mod pair_linear;

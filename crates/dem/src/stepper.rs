@@ -12,6 +12,8 @@
 use crate::contact::{ContactInput, ContactLaw, History, Law, LinearSpringDashpot};
 use crate::domain::Domain;
 use crate::error::DemError;
+use crate::kick_disks::{DiskKick, Eight};
+use crate::lanes::W;
 use crate::neighbor::{CellList, carry_history};
 use crate::pair_linear::LinearPair;
 use crate::system::System;
@@ -280,6 +282,7 @@ impl Stepper {
         self.cstate.resize(nc, CircleState::default());
         let refp = &self.ref_pos;
         let ch = BODY_CHUNK;
+        let dk = DiskKick::new(&dom, dt);
         b.pos
             .par_chunks_mut(ch)
             .zip(b.vel.par_chunks_mut(ch))
@@ -297,7 +300,33 @@ impl Stepper {
                     &refp[r],
                 );
                 let mut worst = 0.0;
-                for l in 0..x.len() {
+                let mut l0 = 0;
+                while l0 + W <= x.len() {
+                    let lanes = l0..l0 + W;
+                    for l in lanes.clone() {
+                        kc[l].refresh(h, m[l], i[l]);
+                    }
+                    let e = Eight {
+                        x: (&mut x[lanes.clone()]).try_into().expect("8"),
+                        v: (&mut v[lanes.clone()]).try_into().expect("8"),
+                        a: (&mut a[lanes.clone()]).try_into().expect("8"),
+                        w: (&mut w[lanes.clone()]).try_into().expect("8"),
+                        st: (&mut st[lanes.clone()]).try_into().expect("8"),
+                        f: f[lanes.clone()].try_into().expect("8"),
+                        t: t[lanes.clone()].try_into().expect("8"),
+                        r: rad[lanes.clone()].try_into().expect("8"),
+                        m: m[lanes.clone()].try_into().expect("8"),
+                        refp: refp[lanes.clone()].try_into().expect("8"),
+                        hm: std::array::from_fn(|k| kc[l0 + k].hm),
+                        hi: std::array::from_fn(|k| kc[l0 + k].hi),
+                    };
+                    match dk.eight(e) {
+                        Some(d) => worst = nan_max(worst, d),
+                        None => break,
+                    }
+                    l0 += W;
+                }
+                for l in l0..x.len() {
                     let kk = &mut kc[l];
                     kk.refresh(h, m[l], i[l]);
                     v[l] += f[l] * kk.hm;
@@ -904,7 +933,7 @@ impl Finish {
 
 /// Maximum that propagates NaN (a non-finite position must stop the run).
 #[inline]
-fn nan_max(p: f64, q: f64) -> f64 {
+pub(crate) fn nan_max(p: f64, q: f64) -> f64 {
     if p.is_nan() || q.is_nan() {
         f64::NAN
     } else {
