@@ -10,8 +10,12 @@
 //! at which the Verlet list was rebuilt (a resumed run continues bit for bit).
 
 use crate::contact::{ContactInput, ContactLaw, History, Law, LinearSpringDashpot};
+use crate::domain::Domain;
 use crate::error::DemError;
+use crate::kick_disks::{DiskKick, Eight};
+use crate::lanes::W;
 use crate::neighbor::{CellList, carry_history};
+use crate::pair_linear::LinearPair;
 use crate::system::System;
 use crate::vector::{Vec2, Vector};
 use crate::wall::update_wall_velocities;
@@ -54,34 +58,76 @@ impl StepParams {
     }
 }
 
-/// Reaction of pair (i, j) on circle j: force and torque (zero when the pair does not touch).
+/// Result of pair (i, j): force on i (j receives −f), torques on i and j; zero when the pair
+/// does not touch. One 32-byte record: the reaction gather reads one cache line per pair.
 #[derive(Clone, Copy, Debug, Default)]
-struct JOut {
-    f: Vec2,
-    t: f64,
+#[repr(C, align(32))]
+pub(crate) struct PairOut {
+    pub fx: f64,
+    pub fy: f64,
+    pub ti: f64,
+    pub tj: f64,
 }
 
-/// Sum over the pairs (i, j > i) of circle i: force, torque and number of touching pairs.
+/// Per body: h/m and h/I of the half kicks, kept while h, m and I stay the same (divisions are
+/// the dearest part of the per-body passes).
 #[derive(Clone, Copy, Debug, Default)]
-struct Acc {
-    f: Vec2,
-    t: f64,
-    n: u32,
+struct Kick {
+    h: f64,
+    m: f64,
+    i: f64,
+    hm: f64,
+    hi: f64,
 }
 
-/// Circles per parallel task of the pair pass (any value gives the same bits).
-const PAIR_CHUNK: usize = 512;
+impl Kick {
+    #[inline(always)]
+    fn refresh(&mut self, h: f64, m: f64, i: f64) {
+        if self.h != h || self.m != m || self.i != i {
+            *self = Kick {
+                h,
+                m,
+                i,
+                hm: h / m,
+                hi: h / i,
+            };
+        }
+    }
+}
+
+/// Bodies per parallel task of the per-body passes (any value gives the same bits).
+const BODY_CHUNK: usize = 512;
+
+/// Circles per task of the fused pair + per-body pass of disk systems (any value gives the
+/// same bits).
+const CIRCLE_CHUNK: usize = 1024;
+
+/// Pairs per parallel task of the pair pass (any value gives the same bits).
+const PAIR_CHUNK: usize = 1024;
 
 /// What the pair loop reads of a circle, packed in one cache line.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(64))]
-struct CircleState {
-    pos: Vec2,
+pub(crate) struct CircleState {
+    pub pos: Vec2,
     /// Velocity of the circle centre.
-    vel: Vec2,
-    omega: f64,
-    r: f64,
-    mass: f64,
+    pub vel: Vec2,
+    pub omega: f64,
+    pub r: f64,
+    pub mass: f64,
+    /// Fills the line (the pair kernel loads whole lines).
+    pub pad: f64,
+}
+
+impl CircleState {
+    /// The line as eight numbers: x, y, vx, vy, ω, r, m, 0 (portable pair kernel).
+    #[cfg(not(target_feature = "avx512f"))]
+    #[inline(always)]
+    pub(crate) fn line(&self) -> [f64; 8] {
+        [
+            self.pos.x, self.pos.y, self.vel.x, self.vel.y, self.omega, self.r, self.mass, self.pad,
+        ]
+    }
 }
 
 /// Scratch for stepping a [`System`].
@@ -94,15 +140,21 @@ pub struct Stepper {
     ref_pos: Vec<Vec2>,
     /// Pairs of circle i (as the lower index) are `pair_start[i]..pair_start[i + 1]`.
     pair_start: Vec<u32>,
-    /// Reaction slots, one per pair.
-    out_j: Vec<JOut>,
-    acc: Vec<Acc>,
+    /// Result of every pair (force on i, torques on i and j; zero when not touching) and
+    /// whether it touches (1) or not (0).
+    out: Vec<PairOut>,
+    touch: Vec<u8>,
     /// Per circle: the pairs in which it is j, ascending i (indices into `out_j`).
     j_start: Vec<u32>,
     j_list: Vec<u32>,
+    /// Circles (ascending) with a reaction from a lower chunk of `CIRCLE_CHUNK` circles, and
+    /// where each chunk's start in that list (the fused disk pass finishes them last).
+    deferred: Vec<u32>,
+    deferred_start: Vec<u32>,
     /// Every body is a single circle at its centre (circle c = body c): fused fast paths.
     all_disks: bool,
     wall_buf: Vec<(Vec2, f64)>,
+    kick: Vec<Kick>,
     n_circles: usize,
     n_bodies: usize,
     checked_dt: f64,
@@ -152,7 +204,7 @@ impl Stepper {
 
     /// Number of pairs in contact at the last force evaluation.
     pub fn n_contacts(&self) -> usize {
-        self.acc.iter().map(|a| a.n as usize).sum()
+        self.touch.iter().map(|&t| t as usize).sum()
     }
 
     /// Advance `sys` by one step.
@@ -165,6 +217,7 @@ impl Stepper {
     ) -> Result<(), DemError> {
         let dt = p.dt;
         let shape = (sys.bodies.n_circles(), sys.bodies.len());
+        self.kick.resize(sys.bodies.len(), Kick::default());
         if self.checked_dt != dt || (self.n_circles, self.n_bodies) != shape {
             let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
             if dt.is_nan() || dt <= 0.0 || dt > crit {
@@ -228,32 +281,75 @@ impl Stepper {
         self.carm.resize(nc, Vec2::ZERO);
         self.cstate.resize(nc, CircleState::default());
         let refp = &self.ref_pos;
+        let ch = BODY_CHUNK;
+        let dk = DiskKick::new(&dom, dt);
         b.pos
-            .par_iter_mut()
-            .zip(b.vel.par_iter_mut())
-            .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
-            .zip(self.cstate.par_iter_mut())
+            .par_chunks_mut(ch)
+            .zip(b.vel.par_chunks_mut(ch))
+            .zip(b.angle.par_chunks_mut(ch).zip(b.omega.par_chunks_mut(ch)))
+            .zip(self.cstate.par_chunks_mut(ch).zip(self.kick.par_chunks_mut(ch)))
             .enumerate()
-            .with_min_len(2048)
-            .map(|(k, (((x, v), (a, w)), st))| {
-                *v += force[k] * (h / mass[k]);
-                *w += torque[k] * h / inertia[k];
-                *x = dom.wrap(*x + *v * dt);
-                *a += *w * dt;
-                *st = CircleState {
-                    pos: *x,
-                    vel: *v,
-                    omega: *w,
-                    r: rad[k],
-                    mass: mass[k],
-                };
-                dom.min_image(*x - refp[k]).norm2()
+            .map(|(c, (((x, v), (a, w)), (st, kc)))| {
+                let r = c * ch..c * ch + x.len();
+                let (f, t, m, i, rad, refp) = (
+                    &force[r.clone()],
+                    &torque[r.clone()],
+                    &mass[r.clone()],
+                    &inertia[r.clone()],
+                    &rad[r.clone()],
+                    &refp[r],
+                );
+                let mut worst = 0.0;
+                let mut l0 = 0;
+                while l0 + W <= x.len() {
+                    let lanes = l0..l0 + W;
+                    for l in lanes.clone() {
+                        kc[l].refresh(h, m[l], i[l]);
+                    }
+                    let e = Eight {
+                        x: (&mut x[lanes.clone()]).try_into().expect("8"),
+                        v: (&mut v[lanes.clone()]).try_into().expect("8"),
+                        a: (&mut a[lanes.clone()]).try_into().expect("8"),
+                        w: (&mut w[lanes.clone()]).try_into().expect("8"),
+                        st: (&mut st[lanes.clone()]).try_into().expect("8"),
+                        f: f[lanes.clone()].try_into().expect("8"),
+                        t: t[lanes.clone()].try_into().expect("8"),
+                        r: rad[lanes.clone()].try_into().expect("8"),
+                        m: m[lanes.clone()].try_into().expect("8"),
+                        refp: refp[lanes.clone()].try_into().expect("8"),
+                        hm: std::array::from_fn(|k| kc[l0 + k].hm),
+                        hi: std::array::from_fn(|k| kc[l0 + k].hi),
+                    };
+                    match dk.eight(e) {
+                        Some(d) => worst = nan_max(worst, d),
+                        None => break,
+                    }
+                    l0 += W;
+                }
+                for l in l0..x.len() {
+                    let kk = &mut kc[l];
+                    kk.refresh(h, m[l], i[l]);
+                    v[l] += f[l] * kk.hm;
+                    w[l] += t[l] * kk.hi;
+                    x[l] = dom.wrap(x[l] + v[l] * dt);
+                    a[l] += w[l] * dt;
+                    st[l] = CircleState {
+                        pos: x[l],
+                        vel: v[l],
+                        omega: w[l],
+                        r: rad[l],
+                        mass: m[l],
+                        pad: 0.0,
+                    };
+                    worst = nan_max(worst, dom.min_image(x[l] - refp[l]).norm2());
+                }
+                worst
             })
             .reduce(|| 0.0, nan_max)
     }
 
     /// Half kick then drift, fused in one pass over the bodies.
-    fn kick_drift(&self, sys: &mut System, h: f64, dt: f64) {
+    fn kick_drift(&mut self, sys: &mut System, h: f64, dt: f64) {
         let dom = sys.domain;
         let b = &mut sys.bodies;
         let (force, mass, torque, inertia) = (&b.force, &b.mass, &b.torque, &b.inertia);
@@ -261,11 +357,13 @@ impl Stepper {
             .par_iter_mut()
             .zip(b.vel.par_iter_mut())
             .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
+            .zip(self.kick.par_iter_mut())
             .enumerate()
             .with_min_len(4096)
-            .for_each(|(k, ((x, v), (a, w)))| {
-                *v += force[k] * (h / mass[k]);
-                *w += torque[k] * h / inertia[k];
+            .for_each(|(k, (((x, v), (a, w)), kk))| {
+                kk.refresh(h, mass[k], inertia[k]);
+                *v += force[k] * kk.hm;
+                *w += torque[k] * kk.hi;
                 *x = dom.wrap(*x + *v * dt);
                 *a += *w * dt;
             });
@@ -303,6 +401,7 @@ impl Stepper {
                     omega: b.omega[k],
                     r: b.circle_r[c],
                     mass: b.mass[k],
+                    pad: 0.0,
                 };
                 if have_ref {
                     dom.min_image(*x - refp[c]).norm2()
@@ -353,8 +452,21 @@ impl Stepper {
             self.j_list[fill[c] as usize] = k as u32;
             fill[c] += 1;
         }
-        self.out_j.resize(pairs.len(), JOut::default());
-        self.acc.resize(nc, Acc::default());
+        self.out.resize(pairs.len(), PairOut::default());
+        self.touch.resize(pairs.len(), 0);
+        // Circles whose lowest partner i lies in an earlier chunk than their own.
+        self.deferred.clear();
+        self.deferred_start.clear();
+        for c0 in (0..nc).step_by(CIRCLE_CHUNK) {
+            self.deferred_start.push(self.deferred.len() as u32);
+            for c in c0..(c0 + CIRCLE_CHUNK).min(nc) {
+                let (a, b) = (self.j_start[c] as usize, self.j_start[c + 1] as usize);
+                if a < b && (pairs[self.j_list[a] as usize][0] as usize) < c0 {
+                    self.deferred.push(c as u32);
+                }
+            }
+        }
+        self.deferred_start.push(self.deferred.len() as u32);
         self.rebuilds += 1;
         Ok(())
     }
@@ -363,78 +475,28 @@ impl Stepper {
     fn forces<L: ContactLaw>(&mut self, p: &StepParams, law: &L, wall_law: &L, sys: &mut System, h: f64) {
         let dt = p.dt;
         let dom = sys.domain;
+        let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
+        if self.all_disks && simple {
+            self.forces_disks(p, law, sys, h);
+            return;
+        }
         let (carm, cst) = (&self.carm, &self.cstate);
-        // 1. Pairs by circle i, in parallel over fixed chunks of circles: the force on i summed
-        //    in ascending j, the reaction on j into the pair's slot.
+        // 1. Every pair, in parallel over fixed chunks of pairs: force on i, torques on i and j.
         {
-            let ps = &self.pair_start;
-            let nc = cst.len();
             let pairs = &sys.contacts.pairs;
-            let mut tasks = Vec::with_capacity(nc.div_ceil(PAIR_CHUNK));
-            let (mut hist, mut outj) = (&mut sys.contacts.hist[..], &mut self.out_j[..]);
-            for (k, acc) in self.acc.chunks_mut(PAIR_CHUNK).enumerate() {
-                let (c0, c1) = (k * PAIR_CHUNK, (k * PAIR_CHUNK + acc.len()));
-                let len = (ps[c1] - ps[c0]) as usize;
-                let (h, hr) = hist.split_at_mut(len);
-                let (o, or) = outj.split_at_mut(len);
-                hist = hr;
-                outj = or;
-                tasks.push((c0, acc, h, o));
-            }
-            tasks.into_par_iter().for_each(|(c0, acc, hist, outj)| {
-                let base = ps[c0] as usize;
-                for (di, a) in acc.iter_mut().enumerate() {
-                    let i = c0 + di;
-                    let ci = &cst[i];
-                    let (mut fa, mut ta, mut na) = (Vec2::ZERO, 0.0, 0u32);
-                    let (q0, q1) = (ps[i] as usize, ps[i + 1] as usize);
-                    for ((pr, h), o) in pairs[q0..q1]
-                        .iter()
-                        .zip(hist[q0 - base..q1 - base].iter_mut())
-                        .zip(outj[q0 - base..q1 - base].iter_mut())
-                    {
-                        let cj = &cst[pr[1] as usize];
-                        let d = dom.min_image(cj.pos - ci.pos);
-                        let (ri, rj) = (ci.r, cj.r);
-                        let rs = ri + rj;
-                        let d2 = d.norm2();
-                        if d2 >= rs * rs {
-                            if *h != History::default() {
-                                *h = History::default();
-                            }
-                            *o = JOut::default();
-                            continue;
-                        }
-                        let dist = d2.sqrt();
-                        let n = d * (1.0 / dist);
-                        let delta = rs - dist;
-                        let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
-                        let (wi, wj) = (ci.omega, cj.omega);
-                        let vi = ci.vel + (n * ai).spin(wi);
-                        let vj = cj.vel - (n * aj).spin(wj);
-                        let (mi, mj) = (ci.mass, cj.mass);
-                        let c = ContactInput {
-                            delta,
-                            n,
-                            v_rel: vi - vj,
-                            w_rel: wi - wj,
-                            r_eff: ri * rj / rs,
-                            m_eff: mi * mj / (mi + mj),
-                            dt,
-                        };
-                        let r = law.force(&c, h);
-                        let nxf = n.cross(r.f);
-                        fa += r.f;
-                        ta += ai * nxf + r.m_roll;
-                        na += 1;
-                        *o = JOut {
-                            f: -r.f,
-                            t: aj * nxf - r.m_roll,
-                        };
-                    }
-                    *a = Acc { f: fa, t: ta, n: na };
-                }
-            });
+            let n = pairs.len();
+            let hist = &mut sys.contacts.hist[..n];
+            let fast = law.linear().and_then(|l| LinearPair::new(l, &dom, dt));
+            let ch = PAIR_CHUNK;
+            pairs
+                .par_chunks(ch)
+                .zip(hist.par_chunks_mut(ch))
+                .zip(self.touch[..n].par_chunks_mut(ch))
+                .zip(self.out[..n].par_chunks_mut(ch))
+                .for_each(|(((pairs, hist), touch), out)| match &fast {
+                    Some(k) => k.run(cst, pairs, hist, out, touch),
+                    None => generic_pairs(law, &dom, dt, cst, pairs, hist, out, touch),
+                });
         }
         // 2. Per body: each circle's own sum plus its reactions in ascending i. Without walls,
         //    bonds or membrane nothing else adds to the contact forces, so body forces, damping
@@ -446,18 +508,25 @@ impl Stepper {
             al: p.local_damping,
             h,
         };
-        let simple = sys.walls.is_empty() && sys.bond_params.is_none() && sys.membrane.is_none();
-        let (outj, acc, js, jl) = (&self.out_j, &self.acc, &self.j_start, &self.j_list);
+        let (out, ps, js, jl) = (&self.out, &self.pair_start, &self.j_start, &self.j_list);
+        // Circle c: its pairs as i in ascending j, then as j in ascending i (the reaction −f).
         let circle_sum = |c: usize| -> (Vec2, f64) {
-            let (mut fc, mut tc) = (acc[c].f, acc[c].t);
+            let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
+            for o in &out[ps[c] as usize..ps[c + 1] as usize] {
+                fc.x += o.fx;
+                fc.y += o.fy;
+                tc += o.ti;
+            }
             for &q in &jl[js[c] as usize..js[c + 1] as usize] {
-                let o = &outj[q as usize];
-                fc += o.f;
-                tc += o.t;
+                let o = &out[q as usize];
+                fc.x -= o.fx;
+                fc.y -= o.fy;
+                tc += o.tj;
             }
             (fc, tc)
         };
         let disks = self.all_disks;
+        let kick = &self.kick;
         let bodies = &mut sys.bodies;
         let Bodies5 {
             force,
@@ -475,7 +544,7 @@ impl Stepper {
             .zip(torque.par_iter_mut())
             .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
             .enumerate()
-            .with_min_len(1024)
+            .with_min_len(512)
             .for_each(|(k, ((f, t), (v, w)))| {
                 if disks {
                     (*f, *t) = circle_sum(k);
@@ -491,7 +560,17 @@ impl Stepper {
                     *t = tb;
                 }
                 if simple {
-                    fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
+                    fin.apply(
+                        f,
+                        t,
+                        v,
+                        w,
+                        mass[k],
+                        inertia[k],
+                        &kick[k],
+                        ext_force[k],
+                        ext_torque[k],
+                    );
                 }
             });
         if simple {
@@ -587,6 +666,7 @@ impl Stepper {
             }
         }
         // 5. Body forces, drivers, damping.
+        let kick = &self.kick;
         let bodies = &mut sys.bodies;
         if let Some(mem) = &sys.membrane {
             for (k, &bk) in mem.bodies.iter().enumerate() {
@@ -613,8 +693,199 @@ impl Stepper {
             .enumerate()
             .with_min_len(1024)
             .for_each(|(k, ((f, t), (v, w)))| {
-                fin.apply(f, t, v, w, mass[k], inertia[k], ext_force[k], ext_torque[k]);
+                fin.apply(
+                    f,
+                    t,
+                    v,
+                    w,
+                    mass[k],
+                    inertia[k],
+                    &kick[k],
+                    ext_force[k],
+                    ext_torque[k],
+                );
             });
+    }
+}
+
+impl Stepper {
+    /// Disks without walls, bonds or membrane: the pair pass and the per-body pass fused per
+    /// chunk of circles, so each chunk's pair results are summed while still in cache. Circle
+    /// c needs the reactions of all its partners i < c; those in the chunk are done before
+    /// it, so every circle without a partner in an earlier chunk is finished in the same task
+    /// (same summation order as the separate passes, hence the same bits); the rest
+    /// (`deferred`) follow in a second pass.
+    fn forces_disks<L: ContactLaw>(&mut self, p: &StepParams, law: &L, sys: &mut System, h: f64) {
+        let (dt, dom) = (p.dt, sys.domain);
+        let fin = Finish {
+            g: p.gravity * p.gravity_factor,
+            gv: p.viscous_damping,
+            al: p.local_damping,
+            h,
+        };
+        let fast = law.linear().and_then(|l| LinearPair::new(l, &dom, dt));
+        let (cst, ps, js, jl, kick) = (
+            &self.cstate,
+            &self.pair_start,
+            &self.j_start,
+            &self.j_list,
+            &self.kick,
+        );
+        let (deferred, dstart) = (&self.deferred, &self.deferred_start);
+        let pairs = &sys.contacts.pairs;
+        let Bodies5 {
+            force,
+            torque,
+            vel,
+            omega,
+            mass,
+            inertia,
+            ext_force,
+            ext_torque,
+            ..
+        } = Bodies5::of(&mut sys.bodies);
+        let nc = force.len();
+        // Sum of circle c and its finish; `out` holds the pairs from `base` on.
+        let finish =
+            |c: usize, out: &[PairOut], base: usize, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64| {
+                let (mut fc, mut tc) = (Vec2::ZERO, 0.0);
+                for o in &out[ps[c] as usize - base..ps[c + 1] as usize - base] {
+                    fc.x += o.fx;
+                    fc.y += o.fy;
+                    tc += o.ti;
+                }
+                for &q in &jl[js[c] as usize..js[c + 1] as usize] {
+                    let o = &out[q as usize - base];
+                    fc.x -= o.fx;
+                    fc.y -= o.fy;
+                    tc += o.tj;
+                }
+                (*f, *t) = (fc, tc);
+                fin.apply(
+                    f,
+                    t,
+                    v,
+                    w,
+                    mass[c],
+                    inertia[c],
+                    &kick[c],
+                    ext_force[c],
+                    ext_torque[c],
+                );
+            };
+        {
+            let mut tasks = Vec::with_capacity(nc.div_ceil(CIRCLE_CHUNK));
+            let (mut hist, mut out, mut touch) =
+                (&mut sys.contacts.hist[..], &mut self.out[..], &mut self.touch[..]);
+            let body = force
+                .chunks_mut(CIRCLE_CHUNK)
+                .zip(torque.chunks_mut(CIRCLE_CHUNK))
+                .zip(vel.chunks_mut(CIRCLE_CHUNK).zip(omega.chunks_mut(CIRCLE_CHUNK)));
+            for (k, bk) in body.enumerate() {
+                let c0 = k * CIRCLE_CHUNK;
+                let c1 = (c0 + CIRCLE_CHUNK).min(nc);
+                let len = (ps[c1] - ps[c0]) as usize;
+                let (hk, hr) = std::mem::take(&mut hist).split_at_mut(len);
+                let (ok, or) = std::mem::take(&mut out).split_at_mut(len);
+                let (tk, tr) = std::mem::take(&mut touch).split_at_mut(len);
+                (hist, out, touch) = (hr, or, tr);
+                tasks.push((k, hk, ok, tk, bk));
+            }
+            tasks
+                .into_par_iter()
+                .for_each(|(k, hist, out, touch, ((f, t), (v, w)))| {
+                    let c0 = k * CIRCLE_CHUNK;
+                    let base = ps[c0] as usize;
+                    let pr = &pairs[base..base + out.len()];
+                    match &fast {
+                        Some(kern) => kern.run(cst, pr, hist, out, touch),
+                        None => generic_pairs(law, &dom, dt, cst, pr, hist, out, touch),
+                    }
+                    let mut skip = deferred[dstart[k] as usize..dstart[k + 1] as usize]
+                        .iter()
+                        .peekable();
+                    for l in 0..f.len() {
+                        let c = c0 + l;
+                        if skip.peek().is_some_and(|&&d| d as usize == c) {
+                            skip.next();
+                            continue;
+                        }
+                        finish(c, out, base, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
+                    }
+                });
+        }
+        // Circles with a partner in an earlier chunk, now that every pair is done.
+        let out = &self.out[..];
+        force
+            .par_chunks_mut(CIRCLE_CHUNK)
+            .zip(torque.par_chunks_mut(CIRCLE_CHUNK))
+            .zip(
+                vel.par_chunks_mut(CIRCLE_CHUNK)
+                    .zip(omega.par_chunks_mut(CIRCLE_CHUNK)),
+            )
+            .enumerate()
+            .for_each(|(k, ((f, t), (v, w)))| {
+                let c0 = k * CIRCLE_CHUNK;
+                for &c in &deferred[dstart[k] as usize..dstart[k + 1] as usize] {
+                    let l = c as usize - c0;
+                    finish(c as usize, out, 0, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
+                }
+            });
+    }
+}
+
+/// The pair pass for any law: force on i, torques on i and j, touching flag.
+#[allow(clippy::too_many_arguments)]
+fn generic_pairs<L: ContactLaw>(
+    law: &L,
+    dom: &Domain,
+    dt: f64,
+    cst: &[CircleState],
+    pairs: &[[u32; 2]],
+    hist: &mut [History],
+    out: &mut [PairOut],
+    touch: &mut [u8],
+) {
+    for (((pr, h), t), o) in pairs.iter().zip(hist).zip(touch).zip(out) {
+        let (ci, cj) = (&cst[pr[0] as usize], &cst[pr[1] as usize]);
+        let d = dom.min_image(cj.pos - ci.pos);
+        let (ri, rj) = (ci.r, cj.r);
+        let rs = ri + rj;
+        let d2 = d.norm2();
+        if d2 >= rs * rs {
+            if *h != History::default() {
+                *h = History::default();
+            }
+            *o = PairOut::default();
+            *t = 0;
+            continue;
+        }
+        let dist = d2.sqrt();
+        let n = d * (1.0 / dist);
+        let delta = rs - dist;
+        let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
+        let (wi, wj) = (ci.omega, cj.omega);
+        let vi = ci.vel + (n * ai).spin(wi);
+        let vj = cj.vel - (n * aj).spin(wj);
+        let (mi, mj) = (ci.mass, cj.mass);
+        let c = ContactInput {
+            delta,
+            n,
+            v_rel: vi - vj,
+            w_rel: wi - wj,
+            r_eff: ri * rj / rs,
+            m_eff: mi * mj / (mi + mj),
+            dt,
+        };
+        let r = law.force(&c, h);
+        let nxf = n.cross(r.f);
+        *o = PairOut {
+            fx: r.f.x,
+            fy: r.f.y,
+            ti: ai * nxf + r.m_roll,
+            tj: aj * nxf - r.m_roll,
+        };
+        *t = 1;
     }
 }
 
@@ -629,7 +900,18 @@ struct Finish {
 impl Finish {
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn apply(&self, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64, m: f64, i: f64, ef: Vec2, et: f64) {
+    fn apply(
+        &self,
+        f: &mut Vec2,
+        t: &mut f64,
+        v: &mut Vec2,
+        w: &mut f64,
+        m: f64,
+        i: f64,
+        kick: &Kick,
+        ef: Vec2,
+        et: f64,
+    ) {
         *f += self.g * m + ef;
         *t += et;
         if self.gv > 0.0 {
@@ -642,15 +924,16 @@ impl Finish {
             *t -= self.al * t.abs() * sign(*w);
         }
         if self.h != 0.0 {
-            *v += *f * (self.h / m);
-            *w += *t * self.h / i;
+            // The opening kick of this step refreshed `kick` for this h.
+            *v += *f * kick.hm;
+            *w += *t * kick.hi;
         }
     }
 }
 
 /// Maximum that propagates NaN (a non-finite position must stop the run).
 #[inline]
-fn nan_max(p: f64, q: f64) -> f64 {
+pub(crate) fn nan_max(p: f64, q: f64) -> f64 {
     if p.is_nan() || q.is_nan() {
         f64::NAN
     } else {

@@ -77,4 +77,7 @@ impl ContactLaw for LinearSpringDashpot {
     fn friction(&self) -> f64 {
         self.mu
     }
+    fn linear(&self) -> Option<&LinearSpringDashpot> {
+        Some(self)
+    }
 }

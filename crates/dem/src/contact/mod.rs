@@ -18,8 +18,10 @@ pub use hertz::HertzMindlin;
 pub use linear::LinearSpringDashpot;
 pub use plastic::ElasticPlastic;
 
-/// Persistent per-contact state carried between steps.
+/// Persistent per-contact state carried between steps (`repr(C)`: the pair kernel loads four
+/// of them as two 512-bit lines).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[repr(C)]
 pub struct History {
     /// Tangential spring elongation.
     pub xi_t: Vec2,
@@ -60,6 +62,11 @@ pub trait ContactLaw: Sync + Send {
     fn max_stiffness(&self, r_eff: f64) -> f64;
     /// Friction coefficient (for diagnostics and generation protocols).
     fn friction(&self) -> f64;
+    /// The law as the linear spring-dashpot, if it is one: the stepper then uses its batched
+    /// pair kernel (same bits as [`ContactLaw::force`]).
+    fn linear(&self) -> Option<&LinearSpringDashpot> {
+        None
+    }
 }
 
 /// How the normal dashpot coefficient is set.
@@ -163,6 +170,12 @@ impl ContactLaw for Law {
             Law::Linear(l) => l.friction(),
             Law::Hertz(l) => l.friction(),
             Law::Plastic(l) => l.friction(),
+        }
+    }
+    fn linear(&self) -> Option<&LinearSpringDashpot> {
+        match self {
+            Law::Linear(l) => Some(l),
+            _ => None,
         }
     }
 }

@@ -1,0 +1,258 @@
+//! The opening half kick, drift, periodic wrap and circle lines of eight disks at a time (the
+//! all-disk path of the stepper). The same IEEE operations in the same order as the scalar loop
+//! in `stepper.rs` (same bits); a batch in which a disk left the box by more than one length is
+//! left to that loop.
+
+use crate::domain::Domain;
+use crate::lanes::{F8, W, deinterleave, interleave, transpose};
+use crate::stepper::CircleState;
+use crate::vector::Vec2;
+
+/// Box constants of one pass.
+pub(crate) struct DiskKick {
+    dt: F8,
+    lo: [F8; 2],
+    hi: [F8; 2],
+    len: [F8; 2],
+    /// Half box length on periodic axes, infinite on open ones (no minimum-image shift).
+    half: [F8; 2],
+    periodic: [bool; 2],
+}
+
+/// The state of eight disks the pass reads and writes.
+pub(crate) struct Eight<'a> {
+    pub x: &'a mut [Vec2; W],
+    pub v: &'a mut [Vec2; W],
+    pub a: &'a mut [f64; W],
+    pub w: &'a mut [f64; W],
+    pub st: &'a mut [CircleState; W],
+    pub f: &'a [Vec2; W],
+    pub t: &'a [f64; W],
+    pub r: &'a [f64; W],
+    pub m: &'a [f64; W],
+    pub refp: &'a [Vec2; W],
+    /// h/m and h/I of the eight disks.
+    pub hm: [f64; W],
+    pub hi: [f64; W],
+}
+
+fn pairs(v: &[Vec2; W]) -> &[[f64; 2]; W] {
+    // SAFETY: Vec2 is repr(C): two f64, no padding.
+    unsafe { &*(v as *const [Vec2; W]).cast::<[[f64; 2]; W]>() }
+}
+
+fn pairs_mut(v: &mut [Vec2; W]) -> &mut [[f64; 2]; W] {
+    // SAFETY: as above.
+    unsafe { &mut *(v as *mut [Vec2; W]).cast::<[[f64; 2]; W]>() }
+}
+
+impl DiskKick {
+    pub(crate) fn new(dom: &Domain, dt: f64) -> Self {
+        let l = dom.size();
+        let half = |p: bool, v: f64| F8::splat(if p { 0.5 * v } else { f64::INFINITY });
+        Self {
+            dt: F8::splat(dt),
+            lo: [F8::splat(dom.lo.x), F8::splat(dom.lo.y)],
+            hi: [F8::splat(dom.hi.x), F8::splat(dom.hi.y)],
+            len: [F8::splat(l.x), F8::splat(l.y)],
+            half: [half(dom.periodic[0], l.x), half(dom.periodic[1], l.y)],
+            periodic: dom.periodic,
+        }
+    }
+
+    /// Kick, drift and lines of eight disks; the largest squared displacement since the list
+    /// build (NaN if any is NaN), or None (nothing written) if a disk must take the far wrap.
+    #[inline(always)]
+    pub(crate) fn eight(&self, e: Eight<'_>) -> Option<f64> {
+        let (fx, fy) = deinterleave(pairs(e.f));
+        let (mut vx, mut vy) = deinterleave(pairs(e.v));
+        let (x0, y0) = deinterleave(pairs(e.x));
+        let (hm, hi) = (F8::from_array(e.hm), F8::from_array(e.hi));
+        // v += F (h/m); ω += T (h/I)
+        vx = vx + fx * hm;
+        vy = vy + fy * hm;
+        let w = F8::from_array(*e.w) + F8::from_array(*e.t) * hi;
+        // x = wrap(x + v dt): one conditional shift per periodic axis (Domain::wrap)
+        let wrap = |p: F8, k: usize| {
+            if self.periodic[k] {
+                let below = p.lt(self.lo[k]);
+                let above = p.ge(self.hi[k]);
+                below.select(p + self.len[k], above.select(p - self.len[k], p))
+            } else {
+                p
+            }
+        };
+        let x = wrap(x0 + vx * self.dt, 0);
+        let y = wrap(y0 + vy * self.dt, 1);
+        let far = |p: F8, k: usize| self.periodic[k] && p.outside(self.lo[k], self.hi[k]).any();
+        if far(x, 0) || far(y, 1) {
+            return None;
+        }
+        let a = F8::from_array(*e.a) + w * self.dt;
+        // Displacement since the list build (Domain::min_image, norm2).
+        let (rx, ry) = deinterleave(pairs(e.refp));
+        let min_image = |d: F8, k: usize| {
+            let shift = d.abs().gt(self.half[k]);
+            shift.select(d - self.len[k].copysign(d), d)
+        };
+        let (dx, dy) = (min_image(x - rx, 0), min_image(y - ry, 1));
+        let d2 = (dx * dx + dy * dy).to_array();
+        interleave(vx, vy, pairs_mut(e.v));
+        interleave(x, y, pairs_mut(e.x));
+        *e.w = w.to_array();
+        *e.a = a.to_array();
+        let rows = transpose([
+            x,
+            y,
+            vx,
+            vy,
+            w,
+            F8::from_array(*e.r),
+            F8::from_array(*e.m),
+            F8::splat(0.0),
+        ]);
+        for (s, row) in e.st.iter_mut().zip(rows) {
+            *s = CircleState {
+                pos: Vec2::new(row[0], row[1]),
+                vel: Vec2::new(row[2], row[3]),
+                omega: row[4],
+                r: row[5],
+                mass: row[6],
+                pad: 0.0,
+            };
+        }
+        Some(d2.into_iter().fold(0.0, crate::stepper::nan_max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scalar loop of `Stepper::kick_drift_disks`, for one disk.
+    #[allow(clippy::too_many_arguments)]
+    fn scalar(
+        dom: &Domain,
+        dt: f64,
+        x: &mut Vec2,
+        v: &mut Vec2,
+        a: &mut f64,
+        w: &mut f64,
+        f: Vec2,
+        t: f64,
+        hm: f64,
+        hi: f64,
+        refp: Vec2,
+    ) -> f64 {
+        *v += f * hm;
+        *w += t * hi;
+        *x = dom.wrap(*x + *v * dt);
+        *a += *w * dt;
+        crate::vector::Vector::norm2(dom.min_image(*x - refp))
+    }
+
+    /// Eight disks, some crossing the periodic boundary, against the scalar loop bit for bit.
+    #[test]
+    fn eight_disks_match_scalar_loop() {
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for periodic in [[true, true], [false, true], [false, false]] {
+            let dom = Domain {
+                lo: Vec2::new(-1.0, 2.0),
+                hi: Vec2::new(3.0, 5.5),
+                periodic,
+            };
+            for _ in 0..200 {
+                let p =
+                    |r: &mut dyn FnMut() -> f64| Vec2::new(-1.0 + 4.0 * (r() + 0.5), 2.0 + 3.5 * (r() + 0.5));
+                let mut x: [Vec2; W] = std::array::from_fn(|_| p(&mut rnd));
+                let mut v: [Vec2; W] = std::array::from_fn(|_| Vec2::new(40.0 * rnd(), 40.0 * rnd()));
+                let mut a: [f64; W] = std::array::from_fn(|_| rnd());
+                let mut w: [f64; W] = std::array::from_fn(|_| rnd());
+                let f: [Vec2; W] = std::array::from_fn(|_| Vec2::new(rnd(), rnd()));
+                let t: [f64; W] = std::array::from_fn(|_| rnd());
+                let r: [f64; W] = std::array::from_fn(|_| rnd() + 1.0);
+                let m: [f64; W] = std::array::from_fn(|_| rnd() + 2.0);
+                let refp: [Vec2; W] = std::array::from_fn(|_| p(&mut rnd));
+                let hm: [f64; W] = std::array::from_fn(|_| rnd());
+                let hi: [f64; W] = std::array::from_fn(|_| rnd());
+                let dt = 0.01;
+                let (mut xs, mut vs, mut as_, mut ws) = (x, v, a, w);
+                let mut worst = 0.0;
+                for k in 0..W {
+                    let d = scalar(
+                        &dom,
+                        dt,
+                        &mut xs[k],
+                        &mut vs[k],
+                        &mut as_[k],
+                        &mut ws[k],
+                        f[k],
+                        t[k],
+                        hm[k],
+                        hi[k],
+                        refp[k],
+                    );
+                    worst = crate::stepper::nan_max(worst, d);
+                }
+                let mut st = [CircleState::default(); W];
+                let got = DiskKick::new(&dom, dt).eight(Eight {
+                    x: &mut x,
+                    v: &mut v,
+                    a: &mut a,
+                    w: &mut w,
+                    st: &mut st,
+                    f: &f,
+                    t: &t,
+                    r: &r,
+                    m: &m,
+                    refp: &refp,
+                    hm,
+                    hi,
+                });
+                let bits = |p: &[Vec2; W]| p.map(|q| (q.x.to_bits(), q.y.to_bits()));
+                assert_eq!(got.map(f64::to_bits), Some(worst.to_bits()));
+                assert_eq!(bits(&x), bits(&xs));
+                assert_eq!(bits(&v), bits(&vs));
+                assert_eq!(a.map(f64::to_bits), as_.map(f64::to_bits));
+                assert_eq!(w.map(f64::to_bits), ws.map(f64::to_bits));
+                for k in 0..W {
+                    assert_eq!((st[k].pos, st[k].vel, st[k].omega), (xs[k], vs[k], ws[k]));
+                    assert_eq!((st[k].r, st[k].mass), (r[k], m[k]));
+                }
+            }
+        }
+    }
+
+    /// A disk that leaves the box by more than one length is left to the scalar loop.
+    #[test]
+    fn far_jump_is_refused() {
+        let dom = Domain::periodic(Vec2::ZERO, Vec2::new(1.0, 1.0));
+        let mut x = [Vec2::new(0.5, 0.5); W];
+        let mut v = [Vec2::ZERO; W];
+        v[3] = Vec2::new(500.0, 0.0);
+        let x0 = x;
+        let (mut a, mut w, mut st) = ([0.0; W], [0.0; W], [CircleState::default(); W]);
+        let got = DiskKick::new(&dom, 0.01).eight(Eight {
+            x: &mut x,
+            v: &mut v,
+            a: &mut a,
+            w: &mut w,
+            st: &mut st,
+            f: &[Vec2::ZERO; W],
+            t: &[0.0; W],
+            r: &[0.1; W],
+            m: &[1.0; W],
+            refp: &[Vec2::new(0.5, 0.5); W],
+            hm: [0.0; W],
+            hi: [0.0; W],
+        });
+        assert_eq!(got, None);
+        assert_eq!(x, x0);
+    }
+}
