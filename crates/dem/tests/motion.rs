@@ -212,3 +212,77 @@ fn energy_conserved_over_1e5_undamped_steps() {
     worst = worst.max((energy(&s, k) - e0).abs() / e0);
     assert!(worst < 1e-4, "relative energy error {worst}");
 }
+
+/// A single disk on the incline: returns (distance moved along the slope, acceleration along it
+/// over the second half of 1 s, final velocity along it, final spin). `lock_spin` gives it an
+/// inertia so large that it cannot turn (a disk held against rolling).
+fn disk_incline(tan_theta: f64, mu: f64, lock_spin: bool) -> (f64, f64, f64, f64) {
+    let (r, g, k) = (0.5, 9.81, 1.0e5);
+    let theta = tan_theta.atan();
+    let shape = ClumpShape::disk(r);
+    let mut bodies = Bodies::new();
+    let area = shape.mass_props().unwrap().area;
+    let b = bodies
+        .add(&shape, 1.0, Vec2::new(0.0, r - area * g * theta.cos() / k), 0.0)
+        .unwrap();
+    if lock_spin {
+        bodies.inertia[b] *= 1e12;
+    }
+    let mut s = System::new(bodies, Domain::open(Vec2::new(-50.0, -5.0), Vec2::new(50.0, 5.0)));
+    s.walls.push(Wall::plane(Vec2::ZERO, Vec2::new(0.0, 1.0)));
+    let law = LinearSpringDashpot::new(k, k / 2.0, Damping::Ratio(0.5), mu);
+    let mut p = StepParams::new(2e-4, 0.05);
+    p.gravity = Vec2::new(g * theta.sin(), -g * theta.cos());
+    let mut st = Stepper::new();
+    let steps = 5000;
+    let mut v_half = 0.0;
+    for n in 0..steps {
+        st.step(&p, &law, &law, &mut s).unwrap();
+        if n == steps / 2 - 1 {
+            v_half = s.bodies.vel[0].x;
+        }
+    }
+    let a = (s.bodies.vel[0].x - v_half) / (0.5 * steps as f64 * p.dt);
+    (s.bodies.pos[0].x, a, s.bodies.vel[0].x, s.bodies.omega[0])
+}
+
+/// A disk on an incline (Coulomb friction; e.g. Kleppner & Kolenkow, An Introduction to
+/// Mechanics, 2nd ed. 2014, Ch. 7). Held against rolling it sticks for tanθ < μ and slides above
+/// with a = g(sinθ − μ cosθ). Free to roll (I = m r²/2) it rolls without slipping while
+/// tanθ < 3μ, with a = (2/3) g sinθ and ω = −v/r, and slides above, with a = g(sinθ − μ cosθ).
+#[test]
+fn disk_on_incline_sticks_or_rolls_and_slides_as_coulomb_says() {
+    let (mu, g, r) = (0.5, 9.81, 0.5);
+    let th = |t: f64| t.atan();
+    let (x, a, _, _) = disk_incline(0.4, mu, true);
+    assert!(
+        x.abs() < 1e-4 && a.abs() < 1e-6,
+        "held disk, tanθ 0.4 < μ: moved {x}, a {a}"
+    );
+    let (x, a, _, _) = disk_incline(0.6, mu, true);
+    let want = g * (th(0.6).sin() - mu * th(0.6).cos());
+    assert!(
+        x > 0.1 && (a - want).abs() < 1e-3 * want,
+        "held disk sliding: a {a} vs {want}"
+    );
+    // Rolling without slip: the contact point stays at rest, v = −ω r.
+    let (_, a, v, w) = disk_incline(0.4, mu, false);
+    let want = 2.0 / 3.0 * g * th(0.4).sin();
+    assert!((a - want).abs() < 2e-3 * want, "rolling: a {a} vs {want}");
+    assert!(
+        (w * r + v).abs() < 1e-3 * v,
+        "rolling: ω r = {} vs v = {v}",
+        -w * r
+    );
+    let (_, a, v, w) = disk_incline(2.0, mu, false);
+    let want = g * (th(2.0).sin() - mu * th(2.0).cos());
+    assert!(
+        (a - want).abs() < 1e-3 * want,
+        "rolling and slipping: a {a} vs {want}"
+    );
+    assert!(
+        -w * r < 0.9 * v,
+        "tanθ = 2 > 3μ must slip: ω r = {} vs v = {v}",
+        -w * r
+    );
+}
