@@ -10,12 +10,13 @@
 //! potential-flow value ρ_p/ρ_f + 1 (the early drag only adds to it; the excess β is printed).
 //! Measured over LBM steps 60-120, once sound has crossed a diameter about twice.
 
+mod common;
+use common::walled_box;
 use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
 use lbdem_coupling::units::CouplingUnits;
-use lbdem_coupling::{Coupled, Hydro, PsmFluid, PsmSettings};
+use lbdem_coupling::{Coupled, Hydro};
 use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::{Bodies, ClumpShape, Damping, Law, StepParams, System, Vec2, generate};
-use lbdem_lbm::{Domain, Face, Limits};
 
 const RHO_F: f64 = 1000.0;
 const G: f64 = 9.81;
@@ -32,19 +33,7 @@ fn early_acceleration(rho_p: f64, correction: bool) -> (f64, f64) {
     let lat = LatticeUnits::derive(&LatticeInput::new(dx, nu, RHO_F, 0.1, TimeSpec::Tau(tau))).unwrap();
     let units = CouplingUnits::new(lat.clone(), [0.0; 2], lat.dt).unwrap();
     let (nx, ny) = ((w / dx).round() as usize, (h / dx).round() as usize);
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let fluid = PsmFluid::<f64>::new(
-        &Domain::new(
-            [nx, ny, 1],
-            [wall, wall, wall, wall, Face::Periodic, Face::Periodic],
-        ),
-        PsmSettings {
-            tau,
-            force: [0.0; 2],
-            limits: Limits::default(),
-        },
-    )
-    .unwrap();
+    let fluid = walled_box(nx, ny, tau);
     let mut b = Bodies::new();
     b.add(
         &ClumpShape::disk(0.5 * d),

@@ -9,12 +9,13 @@
 //! the gap closes below a tenth of a diameter (kissing); the trailing disk ends half a diameter
 //! below the leading one (tumbling). The thresholds are this test's choice, not published ones.
 
+mod common;
+use common::walled_box;
 use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
 use lbdem_coupling::units::CouplingUnits;
-use lbdem_coupling::{Coupled, Hydro, PsmFluid, PsmSettings};
+use lbdem_coupling::{Coupled, Hydro};
 use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::{Bodies, ClumpShape, Damping, Law, StepParams, System, Vec2, Vector, generate};
-use lbdem_lbm::{Domain, Face, Limits};
 
 struct Phases {
     t_draft: Option<f64>,
@@ -30,19 +31,7 @@ fn run(cells_per_diameter: usize, tau: f64, t_end: f64) -> Phases {
     let ratio = 5;
     let units = CouplingUnits::new(lat.clone(), [0.0; 2], lat.dt / ratio as f64).unwrap();
     let (nx, ny) = ((w / dx).round() as usize, (h / dx).round() as usize);
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let fluid = PsmFluid::<f64>::new(
-        &Domain::new(
-            [nx, ny, 1],
-            [wall, wall, wall, wall, Face::Periodic, Face::Periodic],
-        ),
-        PsmSettings {
-            tau,
-            force: [0.0; 2],
-            limits: Limits::default(),
-        },
-    )
-    .unwrap();
+    let fluid = walled_box(nx, ny, tau);
     let mut b = Bodies::new();
     let rho_p = 1010.0;
     b.add(&ClumpShape::disk(0.5 * d), rho_p, Vec2::new(0.01, 0.068), 0.0)

@@ -83,6 +83,14 @@ fn incline_run(tan_theta: f64, mu: f64) -> (f64, f64, f64) {
     let m_area = shape.mass_props().unwrap().area;
     let delta0 = m_area * g * theta.cos() / (3.0 * k);
     bodies.add(&shape, 1.0, Vec2::new(0.0, r - delta0), 0.0).unwrap();
+    let (x, a, _, _) = slide(bodies, theta, g, k, mu);
+    (x, a, g * (theta.sin() - mu * theta.cos()))
+}
+
+/// One body on the plane y = 0 under gravity g tilted by θ, 1 s of the linear law (stiffness k,
+/// friction μ): (distance along the slope, acceleration over the second half, final velocity
+/// along the slope, final spin).
+fn slide(bodies: Bodies, theta: f64, g: f64, k: f64, mu: f64) -> (f64, f64, f64, f64) {
     let mut s = System::new(bodies, Domain::open(Vec2::new(-50.0, -5.0), Vec2::new(50.0, 5.0)));
     s.walls.push(Wall::plane(Vec2::ZERO, Vec2::new(0.0, 1.0)));
     let law = LinearSpringDashpot::new(k, k / 2.0, Damping::Ratio(0.5), mu);
@@ -98,7 +106,7 @@ fn incline_run(tan_theta: f64, mu: f64) -> (f64, f64, f64) {
         }
     }
     let a = (s.bodies.vel[0].x - v_half) / (0.5 * steps as f64 * p.dt);
-    (s.bodies.pos[0].x, a, g * (theta.sin() - mu * theta.cos()))
+    (s.bodies.pos[0].x, a, s.bodies.vel[0].x, s.bodies.omega[0])
 }
 
 /// Block on an incline (Coulomb friction, e.g. Goldstein/any mechanics text): it sticks for
@@ -228,22 +236,7 @@ fn disk_incline(tan_theta: f64, mu: f64, lock_spin: bool) -> (f64, f64, f64, f64
     if lock_spin {
         bodies.inertia[b] *= 1e12;
     }
-    let mut s = System::new(bodies, Domain::open(Vec2::new(-50.0, -5.0), Vec2::new(50.0, 5.0)));
-    s.walls.push(Wall::plane(Vec2::ZERO, Vec2::new(0.0, 1.0)));
-    let law = LinearSpringDashpot::new(k, k / 2.0, Damping::Ratio(0.5), mu);
-    let mut p = StepParams::new(2e-4, 0.05);
-    p.gravity = Vec2::new(g * theta.sin(), -g * theta.cos());
-    let mut st = Stepper::new();
-    let steps = 5000;
-    let mut v_half = 0.0;
-    for n in 0..steps {
-        st.step(&p, &law, &law, &mut s).unwrap();
-        if n == steps / 2 - 1 {
-            v_half = s.bodies.vel[0].x;
-        }
-    }
-    let a = (s.bodies.vel[0].x - v_half) / (0.5 * steps as f64 * p.dt);
-    (s.bodies.pos[0].x, a, s.bodies.vel[0].x, s.bodies.omega[0])
+    slide(bodies, theta, g, k, mu)
 }
 
 /// A disk on an incline (Coulomb friction; e.g. Kleppner & Kolenkow, An Introduction to

@@ -5,6 +5,19 @@ use lbdem_coupling::solid_fraction::{GrainCircle, SolidMap, solid_map};
 use lbdem_coupling::{GrainMotion, Load, PsmFluid, PsmSettings};
 use lbdem_lbm::{Domain, Face, Limits};
 
+/// A PSM lattice of nx × ny nodes walled on all four sides, liquid at rest, BGK at `tau`.
+pub fn walled_box(nx: usize, ny: usize, tau: f64) -> PsmFluid<f64> {
+    let wall = Face::Wall { velocity: [0.0; 3] };
+    PsmFluid::<f64>::new(
+        &Domain::new(
+            [nx, ny, 1],
+            [wall, wall, wall, wall, Face::Periodic, Face::Periodic],
+        ),
+        settings(tau, [0.0; 2]),
+    )
+    .unwrap()
+}
+
 pub fn settings(tau: f64, force: [f64; 2]) -> PsmSettings {
     PsmSettings {
         tau,
