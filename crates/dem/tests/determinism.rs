@@ -178,26 +178,7 @@ fn grain_removal_and_addition_change_packing_fraction() {
 /// stepper: circle sums per body, wall contacts): bitwise identical on 1 and 2 threads.
 #[test]
 fn clumps_with_walls_identical_for_one_and_two_threads() {
-    let grain = ClumpShape {
-        balls: vec![
-            Ball {
-                centre: Vec2::new(-0.2, 0.0),
-                r: 0.4,
-            },
-            Ball {
-                centre: Vec2::new(0.25, 0.0),
-                r: 0.3,
-            },
-        ],
-    };
-    let (lo, hi) = (Vec2::ZERO, Vec2::new(30.0, 30.0));
-    let bodies =
-        generate::random_insert(&[grain, ClumpShape::disk(0.4)], &[3.0, 1.0], 1.0, lo, hi, 600, 5).unwrap();
-    let mut s0 = System::new(bodies, Domain::open(lo, hi));
-    s0.walls = generate::box_walls(lo, hi);
-    let law = LinearSpringDashpot::new(2e4, 2e4 * 2.0 / 7.0, Damping::Gamma(50.0), 0.5);
-    let mut p = StepParams::new(2.0e-4, 0.1);
-    p.gravity = Vec2::new(0.0, -9.81);
+    let (s0, law, p) = common::clumps_in_walled_box(30.0, 600, 5);
     let go = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -87,26 +87,7 @@ fn batched_kernel_identical_for_one_and_two_threads() {
 /// Two-circle clumps and disks under gravity in a walled open box (arms, no periodic images).
 #[test]
 fn batched_kernel_matches_generic_loop_for_clumps() {
-    let grain = ClumpShape {
-        balls: vec![
-            Ball {
-                centre: Vec2::new(-0.2, 0.0),
-                r: 0.4,
-            },
-            Ball {
-                centre: Vec2::new(0.25, 0.0),
-                r: 0.3,
-            },
-        ],
-    };
-    let (lo, hi) = (Vec2::ZERO, Vec2::new(20.0, 20.0));
-    let bodies =
-        generate::random_insert(&[grain, ClumpShape::disk(0.4)], &[3.0, 1.0], 1.0, lo, hi, 300, 9).unwrap();
-    let mut s0 = System::new(bodies, Domain::open(lo, hi));
-    s0.walls = generate::box_walls(lo, hi);
-    let law = LinearSpringDashpot::new(2e4, 2e4 * 2.0 / 7.0, Damping::Gamma(50.0), 0.5);
-    let mut p = StepParams::new(2.0e-4, 0.1);
-    p.gravity = Vec2::new(0.0, -9.81);
+    let (s0, law, p) = common::clumps_in_walled_box(20.0, 300, 9);
     let go = |l: &dyn Fn(&mut Stepper, &mut System)| {
         let mut s = s0.clone();
         let mut st = Stepper::new();

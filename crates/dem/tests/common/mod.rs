@@ -1,4 +1,5 @@
 #![allow(dead_code)]
+use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::*;
 
 /// Two bodies in open space.
@@ -24,4 +25,39 @@ pub fn bits(s: &System) -> Vec<u64> {
         );
     }
     v
+}
+
+/// Two-circle clumps and disks (3:1) inserted at random in a walled open box of side `side`,
+/// under gravity, with the linear law of the determinism tests: the general (non-disk) path of
+/// the stepper.
+pub fn clumps_in_walled_box(side: f64, count: usize, seed: u64) -> (System, LinearSpringDashpot, StepParams) {
+    let grain = ClumpShape {
+        balls: vec![
+            Ball {
+                centre: Vec2::new(-0.2, 0.0),
+                r: 0.4,
+            },
+            Ball {
+                centre: Vec2::new(0.25, 0.0),
+                r: 0.3,
+            },
+        ],
+    };
+    let (lo, hi) = (Vec2::ZERO, Vec2::new(side, side));
+    let bodies = generate::random_insert(
+        &[grain, ClumpShape::disk(0.4)],
+        &[3.0, 1.0],
+        1.0,
+        lo,
+        hi,
+        count,
+        seed,
+    )
+    .unwrap();
+    let mut s = System::new(bodies, Domain::open(lo, hi));
+    s.walls = generate::box_walls(lo, hi);
+    let law = contact::LinearSpringDashpot::new(2e4, 2e4 * 2.0 / 7.0, Damping::Gamma(50.0), 0.5);
+    let mut p = StepParams::new(2.0e-4, 0.1);
+    p.gravity = Vec2::new(0.0, -9.81);
+    (s, law, p)
 }
