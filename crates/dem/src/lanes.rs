@@ -137,6 +137,12 @@ mod imp {
     /// 8 x 8 transpose (lanes of column k become row k).
     #[inline(always)]
     pub(crate) fn transpose(r: [F8; W]) -> [[f64; W]; W] {
+        transpose_registers(r).map(F8::to_array)
+    }
+
+    /// 8 x 8 transpose kept in registers: lane k of result j is lane j of input k.
+    #[inline(always)]
+    pub(crate) fn transpose_registers(r: [F8; W]) -> [F8; W] {
         unsafe {
             let r = r.map(|v| v.0);
             let t = [
@@ -169,7 +175,7 @@ mod imp {
                 _mm512_shuffle_f64x2::<0xDD>(u[1], u[5]),
                 _mm512_shuffle_f64x2::<0xDD>(u[3], u[7]),
             ];
-            c.map(|v| F8(v).to_array())
+            c.map(F8)
         }
     }
 
@@ -324,4 +330,6 @@ mod imp {
     }
 }
 
+#[cfg(target_feature = "avx512f")]
+pub(crate) use imp::transpose_registers;
 pub(crate) use imp::{F8, M8, deinterleave, interleave, transpose};

@@ -358,37 +358,7 @@ mod x86 {
         // (asserted by the caller); CircleState is repr(C), 64 bytes, 64-byte aligned, eight f64.
         unsafe {
             let r: [__m512d; 8] = std::array::from_fn(|k| _mm512_load_pd(p.add(idx[k]).cast::<f64>()));
-            let t = [
-                _mm512_unpacklo_pd(r[0], r[1]),
-                _mm512_unpackhi_pd(r[0], r[1]),
-                _mm512_unpacklo_pd(r[2], r[3]),
-                _mm512_unpackhi_pd(r[2], r[3]),
-                _mm512_unpacklo_pd(r[4], r[5]),
-                _mm512_unpackhi_pd(r[4], r[5]),
-                _mm512_unpacklo_pd(r[6], r[7]),
-                _mm512_unpackhi_pd(r[6], r[7]),
-            ];
-            // u[0]: columns 0/4 of rows 0-3, u[1]: 2/6, u[2]: 1/5, u[3]: 3/7; u[4..]: rows 4-7.
-            let u = [
-                _mm512_shuffle_f64x2::<0x88>(t[0], t[2]),
-                _mm512_shuffle_f64x2::<0xDD>(t[0], t[2]),
-                _mm512_shuffle_f64x2::<0x88>(t[1], t[3]),
-                _mm512_shuffle_f64x2::<0xDD>(t[1], t[3]),
-                _mm512_shuffle_f64x2::<0x88>(t[4], t[6]),
-                _mm512_shuffle_f64x2::<0xDD>(t[4], t[6]),
-                _mm512_shuffle_f64x2::<0x88>(t[5], t[7]),
-                _mm512_shuffle_f64x2::<0xDD>(t[5], t[7]),
-            ];
-            [
-                f8(_mm512_shuffle_f64x2::<0x88>(u[0], u[4])),
-                f8(_mm512_shuffle_f64x2::<0x88>(u[2], u[6])),
-                f8(_mm512_shuffle_f64x2::<0x88>(u[1], u[5])),
-                f8(_mm512_shuffle_f64x2::<0x88>(u[3], u[7])),
-                f8(_mm512_shuffle_f64x2::<0xDD>(u[0], u[4])),
-                f8(_mm512_shuffle_f64x2::<0xDD>(u[2], u[6])),
-                f8(_mm512_shuffle_f64x2::<0xDD>(u[1], u[5])),
-                f8(_mm512_shuffle_f64x2::<0xDD>(u[3], u[7])),
-            ]
+            crate::lanes::transpose_registers(r.map(f8))
         }
     }
 
