@@ -11,12 +11,13 @@
 //!   curves differ from each other by 0.05 d RMS there, printed);
 //! - tumble within the two publications' tumble times, widened on each side by their difference.
 //!
-//! It also prints how far the depths stray, up to the later of the two tumble times, outside the
-//! envelope of the two publications' depths. The aim is a quarter of a diameter (this test's
-//! choice, not a published figure). It is asserted only where the lattice resolves the kissing
-//! pair: the doublet's drag converges slowly with resolution (the pair's midpoint falls at most
-//! 16.9, 17.7 and 18.2 cm/s at 24, 32 and 48 cells per diameter, Koblitz et al. 18.3), so at 24
-//! cells per diameter the pair strays about 0.5 d outside the envelope, at 48 cells 0.1 d.
+//! It also measures how far the depths stray, up to the later of the two tumble times, outside the
+//! envelope of the two publications' depths; the allowance is the publications' own largest
+//! depth difference over that time (0.24 d). That is met only where the lattice resolves the
+//! kissing pair: its drag falls with resolution (the pair's mean depth falls at most at 16.9,
+//! 17.7 and 18.2 cm/s at 24, 32 and 48 cells per diameter, Koblitz et al. 18.3, Uhlmann 19.1),
+//! so at 24 cells per diameter the pair strays 0.48 d outside the envelope (guarded against
+//! getting worse), at 32 cells 0.33 d and at 48 cells 0.10 d (asserted).
 //!
 //! The tumble time depends on the seed of the instability, the initial lateral offset (d/250
 //! either way here): at 16 cells per diameter offsets of d/500, d/250 and d/125 tumble at 0.282,
@@ -24,8 +25,7 @@
 //! diameter (tumble 14 ms inside the band; about 30 s). `cargo test --release -p lbdem-coupling
 //! --test dkt_uhlmann -- --ignored --nocapture` runs 16 cells per diameter with the variants
 //! without the interior-liquid correction and with BGK (to show what each choice does), and the
-//! resolution series 32 and 48 cells per diameter that meets the envelope aim (about 5 minutes on
-//! two cores).
+//! resolution series at 32 and 48 cells per diameter (about 4 minutes on two cores).
 
 use lbdem_coupling::cases::dkt::{DktResult, DktSpec, interpolate, run};
 
@@ -135,17 +135,33 @@ impl Trajectory {
         }
         m
     }
-    /// Fastest fall of the pair's midpoint (m/s) in [t0, t1], by central differences of the
-    /// depths over ±5 ms (the digitised curves are too coarse for less).
-    fn peak_midpoint_speed(&self, t0: f64, t1: f64) -> f64 {
-        let mid = |t: f64| 0.5 * (self.depth_at(0, t) + self.depth_at(1, t));
+    /// Fastest fall (m/s) of the mean depth of the two disks in [t0, t1], and when, by central
+    /// differences over ±5 ms: the digitised curves are 5.5-9 ms apart there. Koblitz et al.'s
+    /// peak hardly depends on the width (18.34-18.38 cm/s for ±2-5 ms), Uhlmann's does (19.35 at
+    /// ±2-3 ms, 19.14 at ±5 ms).
+    fn peak_mean_fall_speed(&self, t0: f64, t1: f64) -> (f64, f64) {
+        let mean = |t: f64| 0.5 * (self.depth_at(0, t) + self.depth_at(1, t));
         let h = 5e-3;
-        (0..=((t1 - t0) * 1e3) as usize)
+        (0..=((t1 - t0) * 1e3).round() as usize)
             .map(|i| {
                 let t = t0 + i as f64 * 1e-3;
-                (mid(t + h) - mid(t - h)) / (2.0 * h)
+                ((mean(t + h) - mean(t - h)) / (2.0 * h), t)
             })
-            .fold(f64::NEG_INFINITY, f64::max)
+            .fold((f64::NEG_INFINITY, t0), |a, b| if b.0 > a.0 { b } else { a })
+    }
+    /// Angle (degrees) of the line of centres from the vertical at time `t`.
+    fn angle(&self, t: f64) -> f64 {
+        let dz = self.depth_at(1, t) - self.depth_at(0, t);
+        let dl = self.lateral_at(1, t) - self.lateral_at(0, t);
+        dl.abs().atan2(dz).to_degrees()
+    }
+    /// Largest difference (degrees) of the line of centres' angle to `other`'s, every 5 ms in
+    /// [t0, t1]: how alike the two pairs tumble.
+    fn max_angle_difference(&self, other: &Self, t0: f64, t1: f64) -> f64 {
+        (0..=((t1 - t0) / 5e-3).round() as usize)
+            .map(|i| t0 + i as f64 * 5e-3)
+            .map(|t| (self.angle(t) - other.angle(t)).abs())
+            .fold(0.0, f64::max)
     }
     /// RMS depth difference (in d) to `other` at `other`'s sample times up to `t1`.
     fn rms_depth_difference(&self, other: &Self, t1: f64) -> f64 {
@@ -166,12 +182,14 @@ struct Verdict {
     rms_drafting: f64,
     tumble: f64,
     tumble_band: (f64, f64),
+    /// Largest distance outside the envelope of the two publications' depths up to the later
+    /// tumble (d), and the allowance: the publications' own largest depth difference over the
+    /// same time.
     outside: f64,
+    allowance: f64,
+    /// Fastest fall of the pair's mean depth (m/s): the kissing doublet's drag.
+    peak_fall: f64,
 }
-
-/// How far outside the published envelope a run should stray at most (in d; this test's choice).
-/// Asserted at 48 cells per diameter, printed at the coarser resolutions.
-const MARGIN: f64 = 0.25;
 
 fn judge(label: &str, spec: &DktSpec) -> Verdict {
     let r = run::<f64>(spec).expect("stable run");
@@ -184,22 +202,26 @@ fn judge(label: &str, spec: &DktSpec) -> Verdict {
     let spread = (tu - tk).abs();
     let band = (tu.min(tk) - spread, tu.max(tk) + spread);
     let t_end = tu.max(tk);
-    let koblitz_vs_uhlmann = k.max_depth_difference(&u, 0.0, t_end);
     let published_drafting = k.rms_depth_difference(&u, T_KISS);
+    let (peak, t_peak) = ours.peak_mean_fall_speed(0.15, 0.25);
     let v = Verdict {
         rms_drafting: ours.rms_depth_difference(&u, T_KISS),
         tumble: ours.tumble_time().unwrap_or(f64::INFINITY),
         tumble_band: band,
         outside: ours.max_outside(&u, &k, t_end),
+        allowance: k.max_depth_difference(&u, 0.0, t_end),
+        peak_fall: peak,
     };
     eprintln!(
         "DKT {label}: {} cells/d, tau {:.4}, TRT {:?}, interior-liquid correction {}, contact range {} cells:\n  \
          depth RMS vs Uhlmann to the kiss ({T_KISS} s) {:.3} d (limit 0.1; Koblitz et al. vs Uhlmann \
          {published_drafting:.3} d)\n  \
          tumble (45°) at {:.4} s; Uhlmann {tu:.4} s, Koblitz et al. {tk:.4} s, band [{:.4}, {:.4}]\n  \
-         up to {t_end:.4} s: largest depth difference to Uhlmann {:.3} d (Koblitz et al.'s: {koblitz_vs_uhlmann:.3} d), \
-         largest distance outside the two publications' envelope {:.3} d (aim {MARGIN}, asserted at 48 cells/d)\n  \
-         fastest fall of the pair's midpoint in [0.15, 0.25] s {:.2} cm/s (Uhlmann {:.2}, Koblitz et al. {:.2})\n  \
+         up to {t_end:.4} s: largest depth difference to Uhlmann {:.3} d (Koblitz et al.'s: {:.3} d), \
+         largest distance outside the two publications' envelope {:.3} d (allowance, asserted at 48 cells/d only: \
+         the publications' own difference, {:.3} d)\n  \
+         fastest fall of the pair's mean depth in [0.15, 0.25] s {:.2} cm/s at {t_peak:.3} s (Uhlmann {:.2}, Koblitz et al. {:.2})\n  \
+         line of centres, 0.20-0.25 s: largest angle difference to Koblitz et al. {:.1}° (Uhlmann's: {:.1}°)\n  \
          smallest gap {:.3} d; {} steps of {} nodes in {:.1} s",
         spec.cells_per_diameter,
         spec.tau,
@@ -211,10 +233,14 @@ fn judge(label: &str, spec: &DktSpec) -> Verdict {
         band.0,
         band.1,
         ours.max_depth_difference(&u, 0.0, t_end),
+        v.allowance,
         v.outside,
-        1e2 * ours.peak_midpoint_speed(0.15, 0.25),
-        1e2 * u.peak_midpoint_speed(0.15, 0.25),
-        1e2 * k.peak_midpoint_speed(0.15, 0.25),
+        v.allowance,
+        1e2 * peak,
+        1e2 * u.peak_mean_fall_speed(0.15, 0.25).0,
+        1e2 * k.peak_mean_fall_speed(0.15, 0.25).0,
+        ours.max_angle_difference(&k, 0.20, 0.25),
+        u.max_angle_difference(&k, 0.20, 0.25),
         r.min_gap / D,
         r.lbm_steps,
         r.nodes,
@@ -240,12 +266,23 @@ fn assert_follows(v: &Verdict) {
         v.tumble,
         v.tumble_band
     );
-    // The envelope (v.outside <= MARGIN) is asserted only by the resolution series below.
+    // The envelope (v.outside <= v.allowance) is asserted only by the resolution series below.
 }
+
+/// At 24 cells per diameter the kissing pair falls too slowly (see the module doc): recorded on
+/// 2026-11-22, 0.48 d outside the envelope. A regression guard on that figure, not agreement
+/// with the publications: a change that makes the kissing phase worse fails here.
+const RECORDED_OUTSIDE_24: f64 = 0.48;
 
 #[test]
 fn two_disks_draft_like_the_publications_and_tumble_within_their_band() {
-    assert_follows(&judge("CI", &spec(24)));
+    let v = judge("CI", &spec(24));
+    assert_follows(&v);
+    assert!(
+        v.outside <= RECORDED_OUTSIDE_24 + 0.05,
+        "the kissing phase got worse: {:.3} d outside the envelope (recorded {RECORDED_OUTSIDE_24} d)",
+        v.outside
+    );
 }
 
 #[test]
@@ -270,9 +307,10 @@ fn coarser_lattice_and_the_variants() {
 }
 
 /// 32 and 48 cells per diameter at u_lattice 0.08 (at 0.15 the gap flow at the kiss goes unstable
-/// at 32 cells): about 1 and 3.5 minutes in release on two cores. The kissing pair's lag behind the
-/// publications must shrink with resolution and, at 48 cells per diameter, stay within `MARGIN`
-/// of their envelope through the first tumble.
+/// at 32 cells): about 1 and 3 minutes in release on two cores. From 32 to 48 cells the kissing
+/// pair must fall faster (its drag is what the coarse lattices get wrong) and stray less from the
+/// publications, and at 48 cells stray from their envelope by no more than they differ from each
+/// other, through the first tumble.
 #[test]
 #[ignore]
 fn finer_lattices_converge_into_the_published_envelope() {
@@ -286,14 +324,18 @@ fn finer_lattices_converge_into_the_published_envelope() {
     let v48 = judge("finest", &fine(48));
     assert_follows(&v48);
     assert!(
-        v48.outside < v32.outside,
-        "no convergence: {:.3} d outside the envelope at 48 cells/d, {:.3} d at 32",
-        v48.outside,
-        v32.outside
+        v48.peak_fall > v32.peak_fall && v48.outside < v32.outside,
+        "no convergence from 32 to 48 cells/d: fastest fall {:.4} -> {:.4} m/s, outside the \
+         envelope {:.3} -> {:.3} d",
+        v32.peak_fall,
+        v48.peak_fall,
+        v32.outside,
+        v48.outside
     );
     assert!(
-        v48.outside <= MARGIN,
-        "at 48 cells/d the pair strays {:.3} d outside the publications' envelope (aim {MARGIN} d)",
-        v48.outside
+        v48.outside <= v48.allowance,
+        "at 48 cells/d the pair strays {:.3} d outside the publications' envelope (allowance {:.3} d)",
+        v48.outside,
+        v48.allowance
     );
 }
