@@ -1,85 +1,192 @@
-//! Command-line definitions. Every stage is a subcommand of its own and also a pipeline
-//! stage; both paths go through [`crate::stages::run_standalone`].
+//! The command line. `run` and `bench` are its own; every other subcommand is a stage kind of
+//! [`crate::registry::STAGES`], run through the same staging path as a pipeline step
+//! ([`crate::pipeline::run_alone`]: atomic outputs, manifest, provenance).
 
-use clap::{Args, Parser, Subcommand};
-use std::path::PathBuf;
+use crate::pipeline::{self, Invocation};
+use crate::registry::{self, CliShape, StageKind};
+use anyhow::{Context, Result};
+use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
+use std::path::{Path, PathBuf};
 
-#[derive(Parser, Debug)]
-#[command(
-    name = "lbdem",
-    version,
-    about = "Radiographs, grains and coupled LBM-DEM simulations of particle-laden liquids"
-)]
-pub struct Cli {
-    #[command(subcommand)]
-    pub command: Command,
-}
-
-#[derive(Subcommand, Debug)]
-pub enum Command {
-    /// Run a pipeline: an ordered list of stages in a TOML file.
-    Run {
-        /// The pipeline file, e.g. pipelines/quickstart.toml.
-        pipeline: PathBuf,
-        /// Rerun every stage even when its inputs and parameters are unchanged.
-        #[arg(long)]
-        force: bool,
-    },
-    /// Radiographs to thickness-corrected solid fraction, REV maps and volumetric strain.
-    Radiograph(StageArgs),
-    /// Make synthetic inputs with a known answer.
-    #[command(subcommand)]
-    Synth(SynthCommand),
-    /// Segment grains in an image and fit two-circle clumps.
-    Digitise(StageArgs),
-    /// Run a scene (fluid, dry DEM or coupled) from its TOML file.
-    Simulate(SimulateArgs),
-    /// Assemble an HTML report from the outputs of earlier stages.
-    Report(StageArgs),
-    /// Benchmarks: print rates and their ratio to a reference measured in the same run.
-    Bench(crate::bench::BenchArgs),
-}
-
-#[derive(Subcommand, Debug)]
-pub enum SynthCommand {
-    /// Forward Beer-Lambert radiographs of a disk assembly with known g_S and eps_vol.
-    Radiograph(StageArgs),
-}
-
-/// Arguments shared by every stage subcommand.
-#[derive(Args, Debug, Clone)]
-pub struct StageArgs {
-    /// The stage's parameters (TOML table, the same keys as in a pipeline's `[stage.params]`).
-    pub params: PathBuf,
-    /// Output directory.
-    #[arg(long, short, default_value = "out")]
-    pub out: PathBuf,
-    /// Override a parameter: `--set key=value` (value parsed as TOML), repeatable.
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
-}
-
-#[derive(Args, Debug, Clone)]
-pub struct SimulateArgs {
-    /// The scene file.
-    pub scene: PathBuf,
-    /// Output directory (default: the scene's `output.dir`, else `out/<scene name>`).
-    #[arg(long, short)]
-    pub out: Option<PathBuf>,
-    /// Continue from the newest checkpoint in the output directory.
-    #[arg(long)]
-    pub resume: bool,
-}
-
-pub fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
-    match cli.command {
-        Command::Run { pipeline, force } => crate::pipeline::run_file(&pipeline, force),
-        Command::Radiograph(a) => crate::stages::run_standalone("radiograph", &a),
-        Command::Synth(SynthCommand::Radiograph(a)) => crate::stages::run_standalone("synth-radiograph", &a),
-        Command::Digitise(a) => crate::stages::run_standalone("digitise", &a),
-        Command::Report(a) => crate::stages::run_standalone("report", &a),
-        Command::Simulate(a) => crate::scenes::simulate(&a.scene, a.out.as_deref(), a.resume),
-        Command::Bench(a) => crate::bench::run(&a),
+/// The `lbdem` command with one subcommand per stage kind.
+pub fn command() -> Command {
+    let mut cmd = Command::new("lbdem")
+        .version(env!("CARGO_PKG_VERSION"))
+        .about("Radiographs, grains and coupled LBM-DEM simulations of particle-laden liquids")
+        .subcommand_required(true)
+        .arg_required_else_help(true)
+        .subcommand(
+            Command::new("run")
+                .about("Run a pipeline: an ordered list of stages in a TOML file")
+                .arg(
+                    Arg::new("pipeline")
+                        .required(true)
+                        .value_parser(clap::value_parser!(PathBuf))
+                        .help("The pipeline file, e.g. pipelines/quickstart.toml"),
+                )
+                .arg(
+                    Arg::new("force")
+                        .long("force")
+                        .action(ArgAction::SetTrue)
+                        .help("Rerun every stage even when its inputs and parameters are unchanged"),
+                ),
+        )
+        .subcommand(crate::bench::BenchArgs::augment_args(
+            Command::new("bench")
+                .about("Benchmarks: print rates and their ratio to a reference measured in the same run"),
+        ));
+    for k in registry::STAGES {
+        cmd = add_stage(cmd, k.cli, k);
     }
+    cmd
+}
+
+/// Add `kind` at `path` below `cmd`, creating the intermediate groups (`synth`).
+fn add_stage(cmd: Command, path: &[&'static str], kind: &'static StageKind) -> Command {
+    match path {
+        [] => cmd,
+        [leaf] => cmd.subcommand(stage_command(leaf, kind)),
+        [group, rest @ ..] => {
+            let group: &'static str = group;
+            let exists = cmd.get_subcommands().any(|c| c.get_name() == group);
+            let cmd = if exists {
+                cmd
+            } else {
+                cmd.subcommand(
+                    Command::new(group)
+                        .about(format!("{group} stages"))
+                        .subcommand_required(true),
+                )
+            };
+            cmd.mut_subcommand(group, |g| add_stage(g, rest, kind))
+        }
+    }
+}
+
+fn stage_command(name: &'static str, kind: &'static StageKind) -> Command {
+    let set = Arg::new("set")
+        .long("set")
+        .value_name("KEY=VALUE")
+        .action(ArgAction::Append)
+        .help(
+            "Override a parameter: `--set key=value` (value parsed as TOML; dotted keys reach into tables)",
+        );
+    let c = Command::new(name).about(kind.about).arg(set);
+    match kind.shape {
+        CliShape::ParamsFile => c
+            .arg(
+                Arg::new("params")
+                    .required(true)
+                    .value_parser(clap::value_parser!(PathBuf))
+                    .help("The stage's parameters (TOML, the same keys as in a pipeline's [stage.params])"),
+            )
+            .arg(
+                Arg::new("out")
+                    .long("out")
+                    .short('o')
+                    .default_value("out")
+                    .value_parser(clap::value_parser!(PathBuf))
+                    .help("Output directory"),
+            ),
+        CliShape::SceneFile => c
+            .arg(
+                Arg::new("scene")
+                    .required(true)
+                    .value_parser(clap::value_parser!(PathBuf))
+                    .help("The scene file (sections [domain], [particles], [fluid], ...; docs/scenes.md)"),
+            )
+            .arg(
+                Arg::new("out")
+                    .long("out")
+                    .short('o')
+                    .value_parser(clap::value_parser!(PathBuf))
+                    .help("Output directory (default: out/<scene name>)"),
+            )
+            .arg(
+                Arg::new("resume")
+                    .long("resume")
+                    .action(ArgAction::SetTrue)
+                    .help("Continue the interrupted run in the output directory from its checkpoint"),
+            ),
+    }
+}
+
+pub fn main() -> Result<()> {
+    let m = command().get_matches();
+    match m.subcommand() {
+        Some(("run", a)) => {
+            let path = a.get_one::<PathBuf>("pipeline").context("PIPELINE is required")?;
+            pipeline::run_file(path, a.get_flag("force"))
+        }
+        Some(("bench", a)) => crate::bench::run(&crate::bench::BenchArgs::from_arg_matches(a)?),
+        Some((name, a)) => {
+            let mut path = vec![name];
+            let mut cur = a;
+            while let Some((sub, sa)) = cur.subcommand() {
+                path.push(sub);
+                cur = sa;
+            }
+            let kind = registry::STAGES
+                .iter()
+                .find(|k| k.cli == path.as_slice())
+                .with_context(|| format!("unknown command {}", path.join(" ")))?;
+            pipeline::run_alone(kind, invocation(kind, cur)?)
+        }
+        None => unreachable!("clap requires a subcommand"),
+    }
+}
+
+/// The stage's parameters, output directory and resume flag from its subcommand's arguments.
+fn invocation(kind: &StageKind, a: &ArgMatches) -> Result<Invocation> {
+    let sets: Vec<String> = a
+        .get_many::<String>("set")
+        .into_iter()
+        .flatten()
+        .cloned()
+        .collect();
+    match kind.shape {
+        CliShape::ParamsFile => {
+            let path = a.get_one::<PathBuf>("params").context("PARAMS is required")?;
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read parameter file {}", path.display()))?;
+            let mut params: toml::Value =
+                toml::from_str(&text).with_context(|| format!("{} is not valid TOML", path.display()))?;
+            registry::apply_overrides(&mut params, &[], &sets)?;
+            Ok(Invocation {
+                params,
+                out: a
+                    .get_one::<PathBuf>("out")
+                    .cloned()
+                    .unwrap_or_else(|| "out".into()),
+                base_dir: parent(path),
+                resume: false,
+            })
+        }
+        CliShape::SceneFile => {
+            let path = a.get_one::<PathBuf>("scene").context("SCENE is required")?;
+            let name = crate::scenes::schema::scene_name(path)?;
+            let scene = path
+                .file_name()
+                .map(PathBuf::from)
+                .unwrap_or_else(|| path.clone());
+            let mut params = toml::Value::Table(toml::Table::from_iter([(
+                "scene".to_string(),
+                toml::Value::String(scene.to_string_lossy().into_owned()),
+            )]));
+            registry::apply_overrides(&mut params, &["overrides"], &sets)?;
+            Ok(Invocation {
+                params,
+                out: a
+                    .get_one::<PathBuf>("out")
+                    .cloned()
+                    .unwrap_or_else(|| PathBuf::from("out").join(name)),
+                base_dir: parent(path),
+                resume: a.get_flag("resume"),
+            })
+        }
+    }
+}
+
+fn parent(p: &Path) -> PathBuf {
+    p.parent().map(Path::to_path_buf).unwrap_or_default()
 }

@@ -2,8 +2,8 @@
 //! an empty image, an image with no grains, a container that covers nothing, a grain
 //! smaller than a few pixels, a missing pixel size.
 
+use lbdem::contract::{Stage, StageContext, StageOutput};
 use lbdem::stages::digitise::Digitise;
-use lbdem::stages::{Stage, StageContext, StageOutput};
 use std::path::Path;
 
 fn save_png(path: &Path, img: &ndarray::Array2<f64>) {

@@ -5,8 +5,8 @@
 //!
 //! Reference count: 29 disks (14 large, 15 small), counted by eye on the photograph.
 
+use lbdem::contract::{Stage, StageContext};
 use lbdem::stages::digitise::Digitise;
-use lbdem::stages::{Stage, StageContext};
 use std::path::Path;
 
 const PHOTO: &str = concat!(

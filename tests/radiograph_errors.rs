@@ -1,8 +1,8 @@
 //! Bad input gets a clear error that names the file or parameter, and nothing is written.
 
+use lbdem::contract::{Stage, StageContext};
 use lbdem::io::tiff::{write_u8, write_u16};
 use lbdem::stages::radiograph::{Params, Radiograph};
-use lbdem::stages::{Stage, StageContext};
 use lbdem_imaging::tiff::encoder::{TiffEncoder, colortype};
 use ndarray::Array2;
 use std::path::Path;

@@ -3,9 +3,9 @@
 //! per pixel must give the thickness, the parabola fit R, and Young-Laplace
 //! dp = -2 gamma / R = -14 kPa for gamma = 0.7 J/m^2 (the paper's figure for R ~ 100 um).
 
+use lbdem::contract::{Stage, StageContext};
 use lbdem::io::tiff::write_f32;
 use lbdem::stages::radiograph::{Params, Radiograph};
-use lbdem::stages::{Stage, StageContext};
 use ndarray::Array2;
 
 #[test]

@@ -2,8 +2,9 @@
 //! it runs, lists its figures and tables for the report, and its mean eps_vol matches the
 //! true one written by the synthetic stage (truth.json) within 0.005.
 
+use lbdem::contract::StageContext;
 use lbdem::pipeline::schema::Pipeline;
-use lbdem::stages::{StageContext, prepare};
+use lbdem::registry;
 use std::path::Path;
 
 #[test]
@@ -13,7 +14,9 @@ fn quickstart_radiograph_stage_runs_on_bundled_frames() {
     let spec = pl.stages.iter().find(|s| s.kind == "radiograph").unwrap();
     let out = tempfile::tempdir().unwrap();
     let ctx = StageContext::new(out.path().into(), spec.name.clone(), pl.root.clone());
-    let o = prepare(&spec.kind, spec.params.clone(), &ctx)
+    let o = registry::find(&spec.kind)
+        .unwrap()
+        .prepare(spec.params.clone(), &ctx)
         .unwrap()
         .run(&ctx)
         .unwrap();

@@ -3,8 +3,8 @@
 //! on an open region, gamma spots) and the ADIC wood-swelling pair (deflate float32 with
 //! NaN masks). Skipped with a message when the data directory is absent.
 
+use lbdem::contract::{Stage, StageContext};
 use lbdem::stages::radiograph::{Params, Radiograph};
-use lbdem::stages::{Stage, StageContext};
 use std::path::{Path, PathBuf};
 
 fn real(sub: &str) -> Option<PathBuf> {

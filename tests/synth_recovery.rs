@@ -3,10 +3,10 @@
 //! by 5% (Su et al. 2020 Eqs. 1-5 with the Eq. 2 or Eq. 3 thickness correction), and
 //! skipping the thickness correction gives a clearly larger error.
 
+use lbdem::contract::{Stage, StageContext};
 use lbdem::io::tiff::read_pages;
 use lbdem::stages::radiograph::{Params as RParams, Radiograph, Thickness};
 use lbdem::stages::synth::{Params as SParams, SynthRadiograph};
-use lbdem::stages::{Stage, StageContext};
 use ndarray::Array2;
 use std::path::Path;
 

@@ -1,20 +1,12 @@
 //! Content-hash cache: a stage is skipped when its kind, parameters, input bytes and the
 //! code version hash to the key stored in its manifest and every output it listed exists.
 
-use super::{MANIFEST, StageRecord, code_version};
-use crate::stages::{Prepared, StageContext};
+use crate::contract::{InputHash, MANIFEST, StageContext, StageRecord, code_version};
+use crate::registry::Prepared;
 use anyhow::{Context, Result};
-use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::io::Read;
 use std::path::{Path, PathBuf};
-
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Eq)]
-pub struct InputHash {
-    pub path: PathBuf,
-    pub sha256: String,
-    pub bytes: u64,
-}
 
 /// SHA-256 of a file (streamed).
 pub fn hash_file(path: &Path) -> Result<InputHash> {
@@ -89,3 +81,17 @@ pub fn reusable(prepared: &Prepared, ctx: &StageContext) -> Result<Option<StageR
     let complete = old.output.files.iter().all(|f| ctx.out_dir.join(f).is_file());
     Ok((old.cache_key == key && complete).then_some(old))
 }
+
+/// Whether the stage's interrupted run (its `.partial` directory) was made with the same key,
+/// so `lbdem run` can continue it instead of starting again.
+pub fn resumable(prepared: &Prepared, ctx: &StageContext) -> Result<bool> {
+    let partial = ctx.out_dir.join(super::PARTIAL);
+    let Ok(stored) = std::fs::read_to_string(partial.join(KEY_FILE)) else {
+        return Ok(false);
+    };
+    let inputs = hash_inputs(&prepared.inputs)?;
+    Ok(stored.trim() == cache_key(&prepared.kind, &prepared.params_json, &inputs))
+}
+
+/// The file in a resumable stage's working directory that holds the key of its run.
+pub const KEY_FILE: &str = "run.key";

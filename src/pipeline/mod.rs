@@ -1,81 +1,116 @@
-//! Pipelines: an ordered list of stages in a TOML file, run with a content-hash cache
-//! and a provenance record (code version, pipeline file, SHA-256 of every input, wall
-//! time of every stage).
+//! The runner: every stage runs through [`execute`], alone (`lbdem <stage>`, [`run_alone`]) or
+//! as a step of a pipeline (`lbdem run`, [`run_file`]): a content-hash cache, atomic outputs,
+//! a `stage.json` manifest and a provenance record (code version, pipeline file, SHA-256 of
+//! every input, wall time of every stage). The runner calls stages; stages never call it.
 
 mod cache;
 pub mod provenance;
 pub mod schema;
 
-use crate::stages::{self, Prepared, StageContext, StageOutput};
-use anyhow::{Context, Result};
-use serde::{Deserialize, Serialize};
-use std::path::Path;
+use crate::contract::{Interrupted, MANIFEST, StageContext, StageRecord, code_version};
+use crate::registry::{self, Prepared, StageKind};
+use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-pub use cache::{InputHash, hash_file};
+pub use cache::{hash_file, hash_inputs};
 
-/// The code version compiled in: crate version and git commit (with `-dirty`).
-pub fn code_version() -> String {
-    format!("{} ({})", env!("CARGO_PKG_VERSION"), env!("LBDEM_GIT_DESCRIBE"))
-}
+/// The working directory of a resumable stage inside its output directory: kept when the
+/// process dies or the stage is [`Interrupted`], so `--resume` can continue it.
+pub const PARTIAL: &str = ".partial";
 
-/// What the runner stores for one executed (or cache-hit) stage in `stage.json`.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct StageRecord {
-    pub name: String,
-    pub kind: String,
-    pub code_version: String,
-    pub cache_key: String,
-    pub params: serde_json::Value,
-    pub inputs: Vec<InputHash>,
-    pub wall_s: f64,
-    /// True when this run reused the outputs of an earlier, identical run.
-    #[serde(default)]
-    pub cached: bool,
-    pub output: StageOutput,
-}
-
-pub const MANIFEST: &str = "stage.json";
-
-/// Stages whose page sits at the top of the pipeline's output: they write their few
-/// files atomically in place instead of through a staging directory.
+/// Stages whose page sits at the top of the pipeline's output: they write their few files
+/// atomically in place instead of through a working directory.
 fn writes_in_place(kind: &str) -> bool {
     kind == "report"
 }
 
 /// Hash the inputs, run the stage and write its manifest atomically.
 ///
-/// Outputs go to a staging directory inside the output directory and are moved into
-/// place only when the stage succeeds: a failed stage leaves nothing behind, and a
-/// directory the run created is removed again.
+/// Outputs go to a working directory inside the output directory and are moved into place
+/// only when the stage succeeds: a failed stage leaves nothing behind, and a directory the run
+/// created is removed again. Resumable stages work in [`PARTIAL`], which survives a killed
+/// process or an [`Interrupted`] stop; with `ctx.resume` the stage continues from it.
 pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
     let inputs = cache::hash_inputs(&prepared.inputs)?;
     let key = cache::cache_key(&prepared.kind, &prepared.params_json, &inputs);
     let created = !ctx.out_dir.exists();
     let staging = if writes_in_place(&prepared.kind) {
         ctx.out_dir.clone()
+    } else if prepared.resumable {
+        ctx.out_dir.join(PARTIAL)
     } else {
         ctx.out_dir.join(format!(".staging-{}", std::process::id()))
     };
+    if ctx.resume {
+        if !prepared.resumable {
+            bail!(
+                "stage '{}' (kind '{}') cannot be resumed: it keeps no checkpoint; run it without --resume",
+                ctx.name,
+                prepared.kind
+            );
+        }
+        if !staging.is_dir() {
+            bail!(
+                "--resume: there is no interrupted run in {} (no {PARTIAL} directory); run without --resume \
+                 to start one",
+                ctx.out_dir.display()
+            );
+        }
+    } else if prepared.resumable && staging.is_dir() {
+        eprintln!(
+            "{:>12}  discarding the interrupted run in {} (use --resume to continue one)",
+            ctx.name,
+            staging.display()
+        );
+        std::fs::remove_dir_all(&staging).with_context(|| format!("cannot remove {}", staging.display()))?;
+    }
     std::fs::create_dir_all(&staging)
         .with_context(|| format!("cannot create output directory {}", staging.display()))?;
-    let result = run_and_record(prepared, &ctx.with_out_dir(staging.clone()), key, inputs);
+    if prepared.resumable {
+        let key_file = staging.join(cache::KEY_FILE);
+        if ctx.resume {
+            let stored = std::fs::read_to_string(&key_file).unwrap_or_default();
+            if stored.trim() != key {
+                bail!(
+                    "--resume: the interrupted run in {} was made with other parameters, inputs or code                      (run key {}, now {key}); run without --resume to start again",
+                    staging.display(),
+                    stored.trim()
+                );
+            }
+        } else {
+            lbdem_core::atomic::write_atomic(&key_file, key.as_bytes())?;
+        }
+    }
+    let mut wctx = ctx.with_out_dir(staging.clone());
+    wctx.key = key.clone();
+    let result = run_and_record(prepared, &wctx, key, inputs);
+    let interrupted = result
+        .as_ref()
+        .err()
+        .is_some_and(|e| e.downcast_ref::<Interrupted>().is_some());
     if staging != ctx.out_dir {
         if result.is_ok() {
             publish(&staging, &ctx.out_dir)?;
         }
-        let _ = std::fs::remove_dir_all(&staging);
+        if !interrupted {
+            let _ = std::fs::remove_dir_all(&staging);
+        }
     }
-    if result.is_err() && created {
+    if result.is_err() && created && !interrupted {
         let _ = std::fs::remove_dir(&ctx.out_dir); // only succeeds when empty
     }
     result
 }
 
-/// Move everything from `staging` into `out`, replacing files of the same name.
+/// Move everything from `staging` into `out` (but the run key of a resumable stage),
+/// replacing files and directories of the same name.
 fn publish(staging: &Path, out: &Path) -> Result<()> {
     for entry in std::fs::read_dir(staging)? {
         let entry = entry?;
+        if entry.file_name() == cache::KEY_FILE {
+            continue;
+        }
         let dest = out.join(entry.file_name());
         if dest.is_dir() {
             std::fs::remove_dir_all(&dest)?;
@@ -90,7 +125,7 @@ fn run_and_record(
     prepared: Prepared,
     ctx: &StageContext,
     key: String,
-    inputs: Vec<InputHash>,
+    inputs: Vec<crate::contract::InputHash>,
 ) -> Result<StageRecord> {
     let (kind, params) = (prepared.kind.clone(), prepared.params_json.clone());
     let t0 = Instant::now();
@@ -106,6 +141,7 @@ fn run_and_record(
         inputs,
         wall_s: t0.elapsed().as_secs_f64(),
         cached: false,
+        resumed: ctx.resume,
         output,
     };
     let json = serde_json::to_vec_pretty(&record)?;
@@ -113,10 +149,36 @@ fn run_and_record(
     Ok(record)
 }
 
+/// One stage run alone from the command line (`lbdem radiograph`, `lbdem simulate`, ...).
+pub struct Invocation {
+    pub params: toml::Value,
+    pub out: PathBuf,
+    /// Relative paths in the parameters resolve from here.
+    pub base_dir: PathBuf,
+    pub resume: bool,
+}
+
+/// `lbdem <stage> ...`: one stage through [`execute`], no cache (it always runs).
+pub fn run_alone(kind: &StageKind, inv: Invocation) -> Result<()> {
+    let mut ctx = StageContext::new(inv.out.clone(), kind.kind.to_string(), inv.base_dir);
+    ctx.resume = inv.resume;
+    let prepared = kind.prepare(inv.params, &ctx)?;
+    let record = execute(prepared, &ctx)?;
+    eprintln!(
+        "{}: wrote {} files to {} in {:.2} s",
+        kind.kind,
+        record.output.files.len(),
+        inv.out.display(),
+        record.wall_s
+    );
+    Ok(())
+}
+
 /// `lbdem run PIPELINE.toml`.
 ///
-/// Every stage's parameters are parsed before anything runs or is written, so a typo in
-/// the last stage fails at once instead of after the long ones.
+/// Every stage's parameters are parsed before anything runs or is written, so a typo in the
+/// last stage fails at once instead of after the long ones. A resumable stage whose earlier
+/// run was interrupted with the same parameters and inputs continues from its checkpoint.
 pub fn run_file(path: &Path, force: bool) -> Result<()> {
     let pipeline = schema::Pipeline::load(path)?;
     let out = pipeline.out_dir();
@@ -131,15 +193,16 @@ pub fn run_file(path: &Path, force: bool) -> Result<()> {
         let mut ctx = StageContext::new(dir.clone(), spec.name.clone(), pipeline.root.clone());
         ctx.earlier = earlier.clone();
         ctx.pipeline_out = Some(out.clone());
-        let prepared = stages::prepare(&spec.kind, spec.params.clone(), &ctx)
+        let prepared = registry::find(&spec.kind)
+            .and_then(|k| k.prepare(spec.params.clone(), &ctx))
             .with_context(|| format!("pipeline file {}", path.display()))?;
         earlier.push((spec.name.clone(), dir));
         planned.push((ctx, prepared));
     }
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
-    let mut prov = provenance::Provenance::start(path, &pipeline)?;
+    let mut prov = provenance::start(path, &pipeline)?;
     let t_all = Instant::now();
-    for (ctx, prepared) in planned {
+    for (mut ctx, prepared) in planned {
         let record = match (force, cache::reusable(&prepared, &ctx)?) {
             (false, Some(mut old)) => {
                 eprintln!(
@@ -150,7 +213,9 @@ pub fn run_file(path: &Path, force: bool) -> Result<()> {
                 old
             }
             _ => {
-                eprintln!("{:>12}  running ({})", ctx.name, prepared.kind);
+                ctx.resume = prepared.resumable && cache::resumable(&prepared, &ctx)?;
+                let how = if ctx.resume { "resuming" } else { "running" };
+                eprintln!("{:>12}  {how} ({})", ctx.name, prepared.kind);
                 let r = execute(prepared, &ctx)?;
                 eprintln!("{:>12}  done in {:.2} s", ctx.name, r.wall_s);
                 r

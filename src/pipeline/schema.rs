@@ -13,6 +13,7 @@
 //! frames = ["data/synth/frame_000.tif"]
 //! ```
 
+use crate::registry;
 use anyhow::{Context, Result, bail};
 use serde::Deserialize;
 use std::collections::HashSet;
@@ -85,13 +86,13 @@ impl Pipeline {
                     s.name
                 );
             }
-            if !crate::stages::KINDS.contains(&s.kind.as_str()) {
+            if registry::find(&s.kind).is_err() {
                 bail!(
                     "pipeline file {}: stage '{}' has unknown kind '{}'; known kinds: {}",
                     path.display(),
                     s.name,
                     s.kind,
-                    crate::stages::KINDS.join(", ")
+                    registry::kinds().join(", ")
                 );
             }
         }

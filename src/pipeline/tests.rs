@@ -2,7 +2,8 @@
 //! any change to inputs, parameters or outputs reruns them.
 
 use super::*;
-use crate::stages::{Prepared, StageContext, StageOutput};
+use crate::contract::{MANIFEST, StageContext, StageOutput};
+use crate::registry::Prepared;
 use std::path::PathBuf;
 
 fn writer_stage(input: PathBuf, param: i64, fail: bool) -> Prepared {

@@ -435,6 +435,26 @@ pub fn circles_overlay_png(path: &Path, image: ArrayView2<f64>, circles: &[Circl
     })
 }
 
+/// Plot `field` as `dir/file`, and record it as a figure (with `caption`) and an output
+/// file: the bookkeeping every map a stage makes needs.
+pub fn field_figure(
+    dir: &Path,
+    file: String,
+    field: ArrayView2<f64>,
+    opts: &FieldPlot,
+    caption: String,
+    figures: &mut Vec<crate::contract::Figure>,
+    files: &mut Vec<std::path::PathBuf>,
+) -> Result<()> {
+    field_png(&dir.join(&file), field, opts)?;
+    figures.push(crate::contract::Figure {
+        path: std::path::PathBuf::from(&file),
+        caption,
+    });
+    files.push(file.into());
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,7 +12,7 @@
 mod export;
 mod load;
 
-use super::{Figure, Stage, StageContext, StageOutput, Table};
+use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::{plot, table};
 use anyhow::{Context, Result, bail};
 use export::{Header, Particle, write_header, write_particles};
@@ -135,6 +135,7 @@ pub struct Digitise;
 
 impl Stage for Digitise {
     const KIND: &'static str = "digitise";
+    const ABOUT: &'static str = "Segment grains in an image and fit two-circle clumps and templates";
     type Params = Params;
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
         p.image_path(ctx).map(|x| vec![x]).unwrap_or_default()

@@ -6,7 +6,7 @@
 //! intensities, positivity, REV size, thickness) is checked before the first file is
 //! written; then frames are processed one by one and written.
 
-use super::{Figure, Stage, StageContext, StageOutput, Table};
+use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::io::tiff as tio;
 use crate::report::{plot, table};
 use anyhow::{Context, Result, bail};
@@ -163,6 +163,8 @@ pub struct Radiograph;
 
 impl Stage for Radiograph {
     const KIND: &'static str = "radiograph";
+    const ABOUT: &'static str =
+        "Radiographs to thickness-corrected solid fraction, REV maps and volumetric strain";
     type Params = Params;
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
         let frames: Vec<PathBuf> = p.frames.iter().map(|f| ctx.resolve(f)).collect();
@@ -494,7 +496,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
             eps_tiles = Some(bl::eps_vol_field(g0t.view(), gs_tiles.view(), p.eps_min_gs));
             if png_frame(n) {
                 let f = format!("{ename}.png");
-                super::field_figure(
+                crate::report::plot::field_figure(
                     out,
                     f,
                     eps.view(),
@@ -517,7 +519,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         }
         if png_frame(n) {
             let f = format!("{gname}.png");
-            super::field_figure(
+            crate::report::plot::field_figure(
                 out,
                 f,
                 gmap.view(),

@@ -3,9 +3,10 @@
 //! writes `index.html` at the top of the pipeline's output directory, so figure links
 //! point into the sibling stage directories.
 
-use super::{Stage, StageContext, StageOutput};
-use crate::pipeline::provenance::{self, Provenance};
-use crate::pipeline::{MANIFEST, StageRecord};
+use crate::contract::{
+    InputHash, MANIFEST, Provenance, Stage, StageContext, StageOutput, StageProvenance, StageRecord,
+    code_version,
+};
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -33,6 +34,7 @@ pub const PAGE: &str = "index.html";
 
 impl Stage for Report {
     const KIND: &'static str = "report";
+    const ABOUT: &'static str = "Assemble an HTML report from the outputs of earlier stages";
     type Params = Params;
 
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
@@ -91,8 +93,8 @@ fn selected(p: &Params, ctx: &StageContext) -> Result<Vec<(String, PathBuf)>> {
 fn standalone_provenance(stages: &[(String, PathBuf)]) -> Provenance {
     Provenance {
         pipeline_name: "(standalone report)".into(),
-        code_version: crate::pipeline::code_version(),
-        pipeline_file: crate::pipeline::InputHash {
+        code_version: code_version(),
+        pipeline_file: InputHash {
             path: PathBuf::from("-"),
             sha256: String::new(),
             bytes: 0,
@@ -104,7 +106,7 @@ fn standalone_provenance(stages: &[(String, PathBuf)]) -> Provenance {
             .filter_map(|(_, d)| {
                 let rec: StageRecord =
                     serde_json::from_str(&std::fs::read_to_string(d.join(MANIFEST)).ok()?).ok()?;
-                Some(provenance::StageProvenance {
+                Some(StageProvenance {
                     name: rec.name,
                     kind: rec.kind,
                     wall_s: rec.wall_s,
@@ -305,7 +307,8 @@ mod tests {
 
     #[test]
     fn page_shows_figures_tables_summary_and_escapes_text() {
-        use crate::stages::{Figure, Prepared, Table};
+        use crate::contract::{Figure, Table};
+        use crate::registry::Prepared;
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("reports/x");
         let input = dir.path().join("in.txt");

@@ -4,7 +4,7 @@
 //! bounce-back, with populations stored in f64 and in f32; each run is one point: its relative
 //! error against the reference and its wall time. Writes the CSV and a log-log PNG.
 
-use super::{Figure, Stage, StageContext, StageOutput, Table};
+use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::plot::{Series, XyPlot, xy_png};
 use anyhow::{Result, bail};
 use lbdem_coupling::Method;
@@ -56,6 +56,8 @@ pub struct SettlingStudy;
 
 impl Stage for SettlingStudy {
     const KIND: &'static str = "settling-study";
+    const ABOUT: &'static str =
+        "Speed against error of the coupling on a settling disk (PSM/bounce-back, f64/f32)";
     type Params = Params;
 
     fn inputs(_: &Params, _: &StageContext) -> Vec<PathBuf> {

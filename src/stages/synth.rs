@@ -13,7 +13,7 @@
 //! the defaults (solid alpha-Al 2700 kg/m^3 with no Cu, as REFERENCES.md; liquid
 //! Al-33wt%Cu at 3400 kg/m^3) are illustrative assumptions, not measured values.
 
-use super::{Stage, StageContext, StageOutput};
+use crate::contract::{Stage, StageContext, StageOutput};
 use crate::io::tiff as tio;
 use crate::report::{plot, table};
 use anyhow::{Context, Result, bail};
@@ -255,6 +255,8 @@ impl Params {
 
 impl Stage for SynthRadiograph {
     const KIND: &'static str = "synth-radiograph";
+    const ABOUT: &'static str =
+        "Forward Beer-Lambert radiographs of a disk assembly with known g_S and eps_vol";
     type Params = Params;
     fn inputs(_: &Params, _: &StageContext) -> Vec<PathBuf> {
         Vec::new()
@@ -357,7 +359,7 @@ impl Stage for SynthRadiograph {
                 files.push(format!("true_eps_vol_{k:03}.tif").into());
                 if p.plots && k + 1 == p.frames {
                     let f = format!("true_eps_vol_{k:03}.png");
-                    super::field_figure(
+                    crate::report::plot::field_figure(
                         out,
                         f,
                         eps.view(),
@@ -385,7 +387,7 @@ impl Stage for SynthRadiograph {
             if p.plots && (k == 0 || k + 1 == p.frames) {
                 let f = format!("frame_{k:03}.png");
                 let ff = frame.mapv(f64::from);
-                super::field_figure(
+                crate::report::plot::field_figure(
                     out,
                     f,
                     ff.view(),

@@ -258,6 +258,11 @@ impl<T: Real> Coupled<T> {
         p
     }
 
+    /// The DEM stepper (its contact list of the last force evaluation).
+    pub fn dem_stepper(&self) -> &Stepper {
+        &self.dem
+    }
+
     /// Number of DEM contacts at the last force evaluation.
     pub fn n_contacts(&self) -> usize {
         self.dem.n_contacts()

@@ -207,6 +207,18 @@ impl Stepper {
         self.touch.iter().map(|&t| t as usize).sum()
     }
 
+    /// Each touching pair (circles i < j) of the last force evaluation with the contact force
+    /// on i (j receives the opposite).
+    pub fn contact_forces<'a>(&'a self, sys: &'a System) -> impl Iterator<Item = ([u32; 2], Vec2)> + 'a {
+        sys.contacts
+            .pairs
+            .iter()
+            .zip(&self.out)
+            .zip(&self.touch)
+            .filter(|(_, t)| **t != 0)
+            .map(|((p, o), _)| (*p, Vec2::new(o.fx, o.fy)))
+    }
+
     /// Advance `sys` by one step.
     pub fn step<L: ContactLaw>(
         &mut self,

@@ -109,6 +109,21 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         Ok(())
     }
 
+    /// The populations of `fluid` in the canonical layout (post-collision, slot i = f_i, as
+    /// `Fluid::f` holds them before `new`), without giving the fluid back: for checkpoints.
+    /// Only after an even number of steps.
+    pub fn canonical(&self, fluid: &Fluid<L, T>) -> Result<Vec<T>, LbmError> {
+        if !self.reversed {
+            return Err(LbmError::Unsupported(
+                "AA populations asked for after an odd number of steps: take one more step first".into(),
+            ));
+        }
+        let n = fluid.nodes();
+        let mut f = self.layout.unpack(&fluid.f, L::Q, n);
+        swap_pairs::<L, T>(&mut f, n);
+        Ok(f)
+    }
+
     /// The padded layout the array is kept in between `new` and `finish`.
     pub fn layout(&self) -> Layout {
         self.layout

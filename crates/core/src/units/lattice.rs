@@ -14,6 +14,13 @@ use serde::{Deserialize, Serialize};
 /// c_s² in lattice units.
 pub const CS2: f64 = 1.0 / 3.0;
 
+/// Mach number above which a set-up gets a warning (Su et al. 2020, after He et al.: Ma < 0.1).
+/// The one default every scene and study uses.
+pub const MACH_WARN: f64 = 0.1;
+
+/// Mach number above which a set-up is refused.
+pub const MACH_MAX: f64 = 0.3;
+
 /// How the time step is fixed.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -54,8 +61,8 @@ impl LatticeInput {
             rho,
             u_max,
             time,
-            mach_warn: 0.1,
-            mach_max: 0.3,
+            mach_warn: MACH_WARN,
+            mach_max: MACH_MAX,
             re_cell_warn: 10.0,
         }
     }

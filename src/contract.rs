@@ -1,0 +1,235 @@
+//! The stage contract: what every stage is given and what it returns, and what the runner
+//! records about it. This module sits at the bottom of the `lbdem` crate and imports nothing
+//! from it, so that stages, scenes, the runner and the CLI can all depend on it without a loop:
+//!
+//! ```text
+//! cli ─► pipeline (runner) ─► registry ─► stages ─► scenes ─► engine crates ─► kernels
+//!   └──────────┴─────────────────┴───────────┴─────────┴──► contract (this module)
+//! ```
+//!
+//! A stage reads files and writes files. It declares its input files (hashed for the cache
+//! and provenance), runs in a directory the runner gives it, and returns a [`StageOutput`]:
+//! figures and tables for the report, every file it wrote, and a JSON summary. The runner
+//! wraps that in a [`StageRecord`] (the `stage.json` manifest) and a [`Provenance`] block.
+
+use anyhow::Result;
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
+use serde::{Deserialize, Serialize, de::DeserializeOwned};
+use std::path::{Path, PathBuf};
+
+/// The file name of a stage's manifest, in its output directory.
+pub const MANIFEST: &str = "stage.json";
+
+/// The file name of a pipeline's provenance record, in its output directory.
+pub const PROVENANCE: &str = "provenance.json";
+
+/// The code version compiled in: crate version and git commit (with `-dirty`).
+pub fn code_version() -> String {
+    format!("{} ({})", env!("CARGO_PKG_VERSION"), env!("LBDEM_GIT_DESCRIBE"))
+}
+
+/// A unit of work that reads files and writes files; run alone from the CLI or as a step of a
+/// pipeline, always through the runner (atomic outputs, manifest, provenance).
+pub trait Stage {
+    /// The `kind` in a pipeline file (and the subcommand name).
+    const KIND: &'static str;
+    /// One line for `lbdem --help`.
+    const ABOUT: &'static str;
+    /// Whether an interrupted run can be continued (`--resume`): its working directory is
+    /// kept when the process dies or the stage stops with [`Interrupted`].
+    const RESUMABLE: bool = false;
+    type Params: DeserializeOwned + Serialize;
+    /// Input files the stage reads (resolved), hashed for the cache and provenance.
+    fn inputs(params: &Self::Params, ctx: &StageContext) -> Vec<PathBuf>;
+    fn run(params: &Self::Params, ctx: &StageContext) -> Result<StageOutput>;
+}
+
+/// A resumable stage stopped on purpose before its end (a wall-clock limit): its working
+/// directory and checkpoint are kept for `--resume`. Returned inside an `anyhow::Error`.
+#[derive(Debug, thiserror::Error)]
+#[error("{reason}; the checkpoint at step {step} is kept: rerun with --resume to continue")]
+pub struct Interrupted {
+    pub reason: String,
+    pub step: u64,
+}
+
+/// What a stage gets besides its parameters.
+pub struct StageContext {
+    /// Where the stage writes (the runner's working directory). Exists when `run` is called.
+    pub out_dir: PathBuf,
+    /// The stage's name in the pipeline (its kind when run alone).
+    pub name: String,
+    /// Directory of the pipeline (or params) file: relative input paths resolve from here.
+    pub base_dir: PathBuf,
+    /// Output directories of earlier stages of the same pipeline, by stage name.
+    pub earlier: Vec<(String, PathBuf)>,
+    /// The pipeline's output directory (None when the stage runs alone).
+    pub pipeline_out: Option<PathBuf>,
+    /// Continue from the checkpoint in `out_dir` (resumable stages only).
+    pub resume: bool,
+    /// The cache key of this run (resumable stages store it in their checkpoint and refuse to
+    /// resume a checkpoint made with other parameters or inputs).
+    pub key: String,
+    progress: MultiProgress,
+}
+
+impl StageContext {
+    pub fn new(out_dir: PathBuf, name: String, base_dir: PathBuf) -> Self {
+        Self {
+            out_dir,
+            name,
+            base_dir,
+            earlier: Vec::new(),
+            pipeline_out: None,
+            resume: false,
+            key: String::new(),
+            progress: MultiProgress::new(),
+        }
+    }
+
+    /// The same context writing somewhere else (the runner's working directory).
+    pub fn with_out_dir(&self, out_dir: PathBuf) -> Self {
+        Self {
+            out_dir,
+            name: self.name.clone(),
+            base_dir: self.base_dir.clone(),
+            earlier: self.earlier.clone(),
+            pipeline_out: self.pipeline_out.clone(),
+            resume: self.resume,
+            key: self.key.clone(),
+            progress: self.progress.clone(),
+        }
+    }
+
+    /// The pipeline's output directory, if the stage runs in a pipeline.
+    pub fn pipeline_dir(&self) -> Option<&Path> {
+        self.pipeline_out.as_deref()
+    }
+
+    /// A progress bar for multi-frame or multi-step work; drawn only on a terminal.
+    pub fn progress_bar(&self, len: u64, message: &str) -> ProgressBar {
+        let pb = self.progress.add(ProgressBar::new(len));
+        pb.set_style(
+            ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({eta})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        pb.set_message(message.to_string());
+        pb
+    }
+
+    /// Resolve a path from the parameters against the pipeline's directory.
+    pub fn resolve(&self, p: &Path) -> PathBuf {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.base_dir.join(p)
+        }
+    }
+
+    /// Output directory of an earlier stage of the pipeline, by name.
+    pub fn earlier_stage(&self, name: &str) -> Option<&Path> {
+        self.earlier
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, p)| p.as_path())
+    }
+}
+
+/// A figure a stage made, path relative to the stage's output directory.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Figure {
+    pub path: PathBuf,
+    pub caption: String,
+}
+
+/// A table (CSV) a stage made, path relative to the stage's output directory.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Table {
+    pub path: PathBuf,
+    pub caption: String,
+}
+
+/// What a stage returns; the runner stores it in the stage's `stage.json` manifest.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct StageOutput {
+    pub summary: serde_json::Value,
+    pub figures: Vec<Figure>,
+    pub tables: Vec<Table>,
+    /// Every file written, relative to the stage's output directory.
+    pub files: Vec<PathBuf>,
+}
+
+/// SHA-256 of one input file.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Eq)]
+pub struct InputHash {
+    pub path: PathBuf,
+    pub sha256: String,
+    pub bytes: u64,
+}
+
+/// What the runner stores for one executed (or cache-hit) stage in `stage.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StageRecord {
+    pub name: String,
+    pub kind: String,
+    pub code_version: String,
+    pub cache_key: String,
+    pub params: serde_json::Value,
+    pub inputs: Vec<InputHash>,
+    pub wall_s: f64,
+    /// True when this run reused the outputs of an earlier, identical run.
+    #[serde(default)]
+    pub cached: bool,
+    /// True when the stage continued an interrupted run from its checkpoint.
+    #[serde(default)]
+    pub resumed: bool,
+    pub output: StageOutput,
+}
+
+/// Provenance of one stage in a pipeline run.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StageProvenance {
+    pub name: String,
+    pub kind: String,
+    pub wall_s: f64,
+    pub cached: bool,
+    pub out_dir: PathBuf,
+    pub inputs: Vec<InputHash>,
+}
+
+/// The provenance block of every report: code version, pipeline file and its hash, the SHA-256
+/// of every input and the wall time of every stage.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Provenance {
+    pub pipeline_name: String,
+    pub code_version: String,
+    pub pipeline_file: InputHash,
+    /// Seconds since the Unix epoch when the run started.
+    pub started_unix_s: u64,
+    pub threads: usize,
+    pub stages: Vec<StageProvenance>,
+    pub total_wall_s: f64,
+}
+
+impl Provenance {
+    pub fn add(&mut self, r: &StageRecord, out_dir: &Path) {
+        self.stages.push(StageProvenance {
+            name: r.name.clone(),
+            kind: r.kind.clone(),
+            wall_s: r.wall_s,
+            cached: r.cached,
+            out_dir: out_dir.to_path_buf(),
+            inputs: r.inputs.clone(),
+        });
+    }
+
+    pub fn write(&self, out: &Path) -> Result<()> {
+        lbdem_core::atomic::write_atomic(&out.join(PROVENANCE), &serde_json::to_vec_pretty(self)?)?;
+        Ok(())
+    }
+
+    pub fn load(out: &Path) -> Option<Self> {
+        serde_json::from_str(&std::fs::read_to_string(out.join(PROVENANCE)).ok()?).ok()
+    }
+}

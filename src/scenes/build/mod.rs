@@ -1,0 +1,7 @@
+//! From sections to engine objects: the DEM system (`dem`), the lattice units and faces
+//! (`lattice`). Shared by every scene that has the section, so a grain assembly is built the
+//! same way in a dry and in a coupled scene.
+
+pub mod dem;
+pub mod lattice;
+mod particles_csv;

@@ -1,0 +1,311 @@
+//! Grains in a liquid: LBM-DEM by partially saturated cells (Su et al. 2020 Fig. 2, Eqs. 9-14)
+//! or moving bounce-back (Leonardi et al. 2014 Eqs. 19-21), one LBM step and its DEM sub-steps
+//! per loop step. The series holds the grains' state, the liquid's mean speed and Mach number,
+//! the pressure change Δp of Eq. 19 (min, max, area below the threshold), the hydrodynamic force
+//! and the total momentum.
+
+use super::contact_list;
+use super::dry::{grain_columns, grain_sample};
+use crate::scenes::build::dem::{build_system, wall_anchor};
+use crate::scenes::build::lattice::{LatticeSetup, setup};
+use crate::scenes::schema::Scene;
+use crate::scenes::snapshot::{FluidFields, write_fluid, write_particles};
+use crate::scenes::timeloop::{Model, Probe};
+use anyhow::{Context, Result, bail};
+use lbdem_coupling::bounce::BounceFluid;
+use lbdem_coupling::units::CouplingUnits;
+use lbdem_coupling::{Coupled, Hydro, Method, PsmFluid, PsmSettings};
+use lbdem_dem::{Vec2, Vector};
+use lbdem_lbm::{Collision, Domain, Limits, Real};
+use std::path::{Path, PathBuf};
+
+/// Build the model of a coupled scene.
+pub fn build(s: &Scene, base: &Path) -> Result<Box<dyn Model>> {
+    let su = setup(s)?;
+    match su.precision.as_str() {
+        "f32" => Ok(Box::new(CoupledModel::<f32>::new(s, su, base)?)),
+        _ => Ok(Box::new(CoupledModel::<f64>::new(s, su, base)?)),
+    }
+}
+
+pub struct CoupledModel<T: Real> {
+    pub run: Coupled<T>,
+    su: LatticeSetup,
+    threshold: f64,
+    wall_start: Vec<Vec2>,
+    pool: rayon::ThreadPool,
+}
+
+impl<T: Real> CoupledModel<T> {
+    fn new(s: &Scene, su: LatticeSetup, base: &Path) -> Result<Self> {
+        let cs = s.coupling.clone().unwrap_or_default();
+        let dem = s.dem.as_ref().context("[dem] is required")?;
+        if s.lattice.as_ref().is_some_and(|l| l.dt.is_none()) {
+            bail!("[lattice]: a coupled scene gives dt (a whole multiple of [dem] dt, Su Table 3), not tau");
+        }
+        if !(cs.depth > 0.0 && cs.depth.is_finite()) {
+            bail!(
+                "[coupling] depth = {}: must be a positive length in m (the sample depth, default 1)",
+                cs.depth
+            );
+        }
+        if let Some((k, _)) = s.walls.iter().enumerate().find(|(_, w)| w.velocity.is_some()) {
+            bail!(
+                "[[walls]] #{k}: moving walls are not seen by the liquid yet (its walls are the [domain] box \
+                 faces, at rest); remove the velocity or use a scene without [fluid]"
+            );
+        }
+        if su.dim != 2 {
+            bail!("a coupled scene is 2D (D2Q9); give [domain] lo and hi with 2 numbers");
+        }
+        for w in &su.units.warnings {
+            eprintln!("coupled: warning: {w}");
+        }
+        let units = CouplingUnits::new(su.units.clone(), s.domain.lo2(), dem.dt)
+            .map_err(|e| anyhow::anyhow!("[lattice] dt and [dem] dt: {e}"))?;
+        let density = s.particles.as_ref().map_or(0.0, |p| p.density);
+        let fluid_density = s.fluid.as_ref().map_or(0.0, |f| f.density);
+        let ratio = 1.0 - fluid_density * cs.depth / density;
+        if (dem.gravity_factor - ratio).abs() > 1e-3 * ratio.abs().max(1e-3) && dem.gravity != [0.0; 2] {
+            eprintln!(
+                "coupled: note: [dem] gravity_factor = {} but 1 - rho_L depth / density = {ratio:.4}; \
+                 the buoyancy of Su et al. Sect. 2.4 uses the latter",
+                dem.gravity_factor
+            );
+        }
+        let sys = build_system(s, base)?;
+        let [nx, ny, _] = su.n;
+        let domain = Domain::new(su.n, su.faces);
+        let tau = su.units.tau;
+        let limits = Limits::default();
+        let trt = match su.collision {
+            Collision::Trt { magic, .. } => Some(magic),
+            Collision::Bgk { .. } => None,
+        };
+        let hydro = match cs.method {
+            Method::Psm => {
+                let mut fluid = PsmFluid::<T>::new(
+                    &domain,
+                    PsmSettings {
+                        tau,
+                        force: [su.force[0], su.force[1]],
+                        limits,
+                    },
+                )?;
+                if let Some(m) = trt {
+                    fluid = fluid
+                        .with_trt(m)
+                        .map_err(|e| anyhow::anyhow!("[lattice] magic: {e}"))?;
+                }
+                Hydro::psm(fluid)
+            }
+            Method::BounceBack => {
+                if trt.is_some() {
+                    bail!(
+                        "[lattice] collision = \"trt\" is for [coupling] method = \"psm\" only; use collision = \"bgk\""
+                    );
+                }
+                if cs.interior_liquid_correction {
+                    bail!("[coupling] interior_liquid_correction is for method = \"psm\" only; remove it");
+                }
+                Hydro::BounceBack(Box::new(BounceFluid::<T>::new(
+                    domain,
+                    tau,
+                    [su.force[0], su.force[1]],
+                    limits,
+                )?))
+            }
+        };
+        let law = s.contact.clone().context("[contact] is required")?;
+        let wall_law = s.wall_contact.clone().unwrap_or_else(|| law.clone());
+        let mut run = Coupled::new(hydro, sys, law, wall_law, dem.step_params(), units, cs.r_hd)
+            .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;
+        run.depth = cs.depth;
+        if cs.dry_membrane {
+            for k in 0..run.sys.bodies.len() {
+                run.dry[k] = run.sys.bodies.tag[k] == 1;
+            }
+        }
+        if cs.interior_liquid_correction {
+            run = run
+                .with_interior_liquid_correction()
+                .map_err(|e| anyhow::anyhow!("[coupling] interior_liquid_correction = true: {e}"))?;
+        }
+        eprintln!(
+            "coupled: {} grains, lattice {nx} x {ny} (dx = {:e} m, tau = {tau:.4}), LBM dt = {:e} s, \
+             DEM dt = {:e} s, ratio {}, {:?}, {}",
+            run.sys.bodies.len(),
+            run.units.dx(),
+            run.units.dt(),
+            run.units.dt_dem,
+            run.units.ratio,
+            cs.method,
+            T::NAME
+        );
+        let threads = s.run.threads;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .context("cannot start the thread pool")?;
+        let wall_start = run.sys.walls.iter().map(wall_anchor).collect();
+        Ok(Self {
+            run,
+            su,
+            threshold: s.output.pressure_threshold,
+            wall_start,
+            pool,
+        })
+    }
+
+    /// Δp of every node (Pa, Su Eq. 19); NaN off the liquid.
+    pub fn pressure_change(&self) -> Vec<f64> {
+        self.run
+            .fluid
+            .pressure_change()
+            .into_iter()
+            .map(|p| self.run.units.pressure_to_si(p))
+            .collect()
+    }
+
+    pub fn lattice_size(&self) -> [usize; 2] {
+        [self.su.n[0], self.su.n[1]]
+    }
+}
+
+impl<T: Real> Model for CoupledModel<T> {
+    fn step(&mut self, _fields: bool) -> Result<()> {
+        let run = &mut self.run;
+        self.pool
+            .install(|| run.step())
+            .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))
+    }
+    fn steps_done(&self) -> u64 {
+        self.run.sys.step / u64::from(self.run.units.ratio)
+    }
+    fn time(&self) -> f64 {
+        self.steps_done() as f64 * self.run.units.dt()
+    }
+    fn dt(&self) -> f64 {
+        self.run.units.dt()
+    }
+    fn series_columns(&self) -> Vec<String> {
+        let mut c = grain_columns(self.run.sys.walls.len());
+        c.extend(
+            [
+                "mean_liquid_speed",
+                "max_mach",
+                "dp_min",
+                "dp_max",
+                "area_below_threshold",
+                "hydro_fx",
+                "hydro_fy",
+                "momentum_x",
+                "momentum_y",
+            ]
+            .map(String::from),
+        );
+        c
+    }
+    fn sample(&self) -> Vec<f64> {
+        let run = &self.run;
+        let [nx, ny] = run.fluid.size();
+        let u = &run.units;
+        let vscale = u.dx() / u.dt();
+        let (mut speed_sum, mut n_active, mut max_u) = (0.0, 0usize, 0.0f64);
+        for i in 0..nx * ny {
+            let (rho, v) = run.fluid.node(i);
+            if rho.is_finite() {
+                let s = (v[0] * v[0] + v[1] * v[1]).sqrt();
+                speed_sum += s;
+                max_u = max_u.max(s);
+                n_active += 1;
+            }
+        }
+        let dp = self.pressure_change();
+        let (lo, hi) = crate::report::plot::finite_range(dp.iter().copied()).unwrap_or((0.0, 0.0));
+        let below = dp.iter().filter(|&&p| p < self.threshold).count() as f64 * u.dx() * u.dx();
+        let hydro = run
+            .hydro
+            .iter()
+            .fold([0.0; 2], |a, l| [a[0] + l.force[0], a[1] + l.force[1]]);
+        let mom = run.momentum();
+        let mut v = grain_sample(&run.sys, run.dem_stepper());
+        v.extend([
+            speed_sum / n_active.max(1) as f64 * vscale,
+            max_u * 3f64.sqrt(),
+            lo,
+            hi,
+            below,
+            hydro[0],
+            hydro[1],
+            mom[0],
+            mom[1],
+        ]);
+        v
+    }
+    fn probe(&self, q: Probe) -> Option<f64> {
+        match q {
+            Probe::MaxGrainSpeed => Some(self.run.sys.bodies.max_speed()),
+            Probe::WallDisplacement(k) => {
+                let w = self.run.sys.walls.get(k)?;
+                Some((wall_anchor(w) - self.wall_start[k]).norm())
+            }
+            Probe::MeanLiquidSpeed => Some(self.sample()[self.series_columns().len() - 9]),
+        }
+    }
+    fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {
+        let run = &self.run;
+        let [nx, ny] = run.fluid.size();
+        let u = &run.units;
+        let vscale = u.dx() / u.dt();
+        let mut velocity = Vec::with_capacity(3 * nx * ny);
+        for i in 0..nx * ny {
+            let (rho, v) = run.fluid.node(i);
+            if rho.is_finite() {
+                velocity.extend([v[0] * vscale, v[1] * vscale, 0.0]);
+            } else {
+                velocity.extend([f64::NAN; 3]);
+            }
+        }
+        let solid = match &run.fluid {
+            Hydro::Psm { map, .. } => map.total.clone(),
+            Hydro::BounceBack(b) => b.fluid.domain.kind.iter().map(|&k| f64::from(k != 0)).collect(),
+        };
+        let f = FluidFields {
+            n: self.su.n,
+            lo: self.su.lo,
+            dx: u.dx(),
+            velocity,
+            pressure: self.pressure_change(),
+            solid_fraction: Some(solid),
+            node_kind: None,
+        };
+        let mut out = write_fluid(dir, self.steps_done(), &f)?;
+        // The particle files carry the LBM step in their name too, so one step's files sort together.
+        let mut sys = run.sys.clone();
+        sys.step = self.steps_done();
+        out.extend(write_particles(
+            dir,
+            &sys,
+            &contact_list(run.dem_stepper(), &run.sys),
+        )?);
+        Ok(out)
+    }
+    fn describe(&self) -> serde_json::Value {
+        let tm = self.run.timing;
+        let total = (tm.lbm + tm.dem + tm.coupling).as_secs_f64().max(1e-12);
+        serde_json::json!({
+            "dem_steps_per_lbm_step": self.run.units.ratio, "grains": self.run.sys.bodies.len(),
+            "lattice": self.lattice_size(), "dx": self.run.units.dx(), "tau": self.su.units.tau, "method": self.run.fluid.method(),
+            "precision": T::NAME, "collision": self.su.collision,
+            "time_share": { "lbm": tm.lbm.as_secs_f64() / total, "dem": tm.dem.as_secs_f64() / total,
+                            "coupling": tm.coupling.as_secs_f64() / total },
+        })
+    }
+    fn save(&self) -> Result<serde_json::Value> {
+        bail!("TODO(merge): coupled checkpoints come with the coupling crate's state export")
+    }
+    fn restore(&mut self, _state: serde_json::Value) -> Result<()> {
+        bail!("TODO(merge): coupled checkpoints come with the coupling crate's state export")
+    }
+}

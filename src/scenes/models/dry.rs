@@ -1,0 +1,162 @@
+//! Grains only: the DEM system of the scene stepped by `lbdem_dem::Stepper` (one DEM step per
+//! loop step), after the optional `[compress]` preparation (Su et al. 2020 Sect. 2.4).
+
+use super::contact_list;
+use crate::scenes::build::dem::{build_system, wall_anchor};
+use crate::scenes::schema::Scene;
+use crate::scenes::snapshot::write_particles;
+use crate::scenes::timeloop::{Model, Probe};
+use anyhow::{Context, Result};
+use lbdem_dem::{ContactLaw, Law, StepParams, Stepper, System, Vec2, Vector};
+use std::path::{Path, PathBuf};
+
+pub struct Dry {
+    pub sys: System,
+    stepper: Stepper,
+    law: Law,
+    wall_law: Law,
+    params: StepParams,
+    /// Where each wall started (the displacement stop condition).
+    wall_start: Vec<Vec2>,
+    pub critical_dt: f64,
+}
+
+impl Dry {
+    /// Build from the scene; `prepare` runs the `[compress]` preparation (not on resume: the
+    /// checkpoint holds the prepared state).
+    pub fn build(s: &Scene, base: &Path, prepare: bool) -> Result<Self> {
+        let mut sys = build_system(s, base)?;
+        let law = s.contact.clone().context("[contact] is required")?;
+        let wall_law = s.wall_contact.clone().unwrap_or_else(|| law.clone());
+        let params = s.dem.as_ref().context("[dem] is required")?.step_params();
+        let (crit, m_min, k_max) = Stepper::critical_time_step(&sys, &law, &wall_law);
+        eprintln!(
+            "dem: {} bodies, dt = {:e} s, critical {crit:e} s (m_min {m_min:e} kg, k_max {k_max:e} N/m), law {}",
+            sys.bodies.len(),
+            params.dt,
+            law_name(&law)
+        );
+        let mut stepper = Stepper::new();
+        if let (Some(c), true) = (&s.compress, prepare) {
+            let n = lbdem_dem::generate::compress_isotropic(
+                &mut sys,
+                &law,
+                &wall_law,
+                &params,
+                &c.to_kernel(),
+                &mut stepper,
+            )
+            .context("[compress]")?;
+            eprintln!(
+                "dem: isotropic compression took {n} steps, packing fraction {:.4}",
+                sys.packing_fraction()
+            );
+            if let Some(phi) = c.target_packing {
+                lbdem_dem::generate::scale_to_packing(&mut sys, phi);
+            }
+            sys.step = 0;
+            sys.time = 0.0;
+            stepper = Stepper::new();
+        }
+        let wall_start = sys.walls.iter().map(wall_anchor).collect();
+        Ok(Self {
+            sys,
+            stepper,
+            law,
+            wall_law,
+            params,
+            wall_start,
+            critical_dt: crit,
+        })
+    }
+
+    pub fn law(&self) -> &Law {
+        &self.law
+    }
+}
+
+pub fn law_name(l: &Law) -> &'static str {
+    let _ = l.friction();
+    match l {
+        Law::Linear(_) => "linear",
+        Law::Hertz(_) => "hertz",
+        Law::Plastic(_) => "plastic",
+    }
+}
+
+/// Series columns of a grain system with `walls` walls.
+pub fn grain_columns(walls: usize) -> Vec<String> {
+    let mut c: Vec<String> = ["kinetic_energy", "packing_fraction", "contacts", "max_speed"]
+        .map(String::from)
+        .to_vec();
+    for w in 0..walls {
+        c.push(format!("wall{w}_fx"));
+        c.push(format!("wall{w}_fy"));
+    }
+    c
+}
+
+/// Series values of a grain system (same order as [`grain_columns`]).
+pub fn grain_sample(sys: &System, st: &Stepper) -> Vec<f64> {
+    let mut v = vec![
+        sys.bodies.kinetic_energy(),
+        sys.packing_fraction(),
+        st.n_contacts() as f64,
+        sys.bodies.max_speed(),
+    ];
+    for w in &sys.walls {
+        v.push(w.force.x);
+        v.push(w.force.y);
+    }
+    v
+}
+
+impl Model for Dry {
+    fn step(&mut self, _fields: bool) -> Result<()> {
+        self.stepper
+            .step_law(&self.params, &self.law, &self.wall_law, &mut self.sys)
+            .map_err(|e| anyhow::anyhow!("{e} (set [dem] dt in the scene file)"))
+    }
+    fn steps_done(&self) -> u64 {
+        self.sys.step
+    }
+    fn time(&self) -> f64 {
+        self.sys.time
+    }
+    fn dt(&self) -> f64 {
+        self.params.dt
+    }
+    fn series_columns(&self) -> Vec<String> {
+        grain_columns(self.sys.walls.len())
+    }
+    fn sample(&self) -> Vec<f64> {
+        grain_sample(&self.sys, &self.stepper)
+    }
+    fn probe(&self, q: Probe) -> Option<f64> {
+        match q {
+            Probe::MaxGrainSpeed => Some(self.sys.bodies.max_speed()),
+            Probe::WallDisplacement(k) => {
+                let w = self.sys.walls.get(k)?;
+                Some((wall_anchor(w) - self.wall_start[k]).norm())
+            }
+            Probe::MeanLiquidSpeed => None,
+        }
+    }
+    fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {
+        write_particles(dir, &self.sys, &contact_list(&self.stepper, &self.sys))
+    }
+    fn describe(&self) -> serde_json::Value {
+        serde_json::json!({
+            "bodies": self.sys.bodies.len(), "contact_law": law_name(&self.law),
+            "critical_time_step": self.critical_dt, "packing_fraction": self.sys.packing_fraction(),
+        })
+    }
+    fn save(&self) -> Result<serde_json::Value> {
+        Ok(serde_json::to_value(&self.sys)?)
+    }
+    fn restore(&mut self, state: serde_json::Value) -> Result<()> {
+        self.sys = serde_json::from_value(state)?;
+        self.stepper = Stepper::new();
+        Ok(())
+    }
+}

@@ -1,0 +1,22 @@
+//! The engines as the time loop sees them ([`crate::scenes::timeloop::Model`]): grains only
+//! (`dry`), liquid only (`fluid`), grains in a liquid (`coupled`). Each is built from the
+//! scene's sections, steps its engine, samples the series, writes snapshots and saves its
+//! whole state for `--resume`.
+
+pub mod coupled;
+pub mod dry;
+pub mod fluid;
+
+use crate::scenes::snapshot::ContactForce;
+use lbdem_dem::{Stepper, System};
+
+/// The touching pairs of the last force evaluation, for the contact table.
+pub fn contact_list(st: &Stepper, sys: &System) -> Vec<ContactForce> {
+    st.contact_forces(sys)
+        .map(|(p, f)| ContactForce {
+            i: p[0],
+            j: p[1],
+            force: [f.x, f.y],
+        })
+        .collect()
+}

@@ -1,0 +1,130 @@
+//! Stop conditions: every grain slower than a threshold, a steady liquid, a wall moved far
+//! enough (these end the run, whose final outputs are then written), and a wall-clock limit
+//! (which interrupts it with a checkpoint for `--resume`).
+
+use crate::scenes::timeloop::{Flow, LoopCtx, Model, Observer, Probe, Trigger};
+use anyhow::Result;
+use std::time::Instant;
+
+/// Stop when every grain is slower than `v` (m/s).
+pub struct SlowerThan {
+    pub v: f64,
+    pub trigger: Trigger,
+}
+
+impl Observer for SlowerThan {
+    fn name(&self) -> &'static str {
+        "until_slower_than"
+    }
+    fn trigger(&self) -> &Trigger {
+        &self.trigger
+    }
+    fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
+        Ok(match m.probe(Probe::MaxGrainSpeed) {
+            Some(s) if s < self.v => Flow::Stop(format!(
+                "every grain slower than {:e} m/s at step {}",
+                self.v,
+                m.steps_done()
+            )),
+            _ => Flow::Continue,
+        })
+    }
+}
+
+/// Stop when the mean liquid speed changes by less than `tol` (relative) between two checks.
+pub struct Steady {
+    pub tol: f64,
+    pub trigger: Trigger,
+    pub last: Option<f64>,
+}
+
+impl Observer for Steady {
+    fn name(&self) -> &'static str {
+        "until_steady"
+    }
+    fn trigger(&self) -> &Trigger {
+        &self.trigger
+    }
+    fn needs_fields(&self) -> bool {
+        true
+    }
+    fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
+        let Some(mean) = m.probe(Probe::MeanLiquidSpeed) else {
+            return Ok(Flow::Continue);
+        };
+        let steady = self
+            .last
+            .is_some_and(|prev| (mean - prev).abs() <= self.tol * mean.abs().max(f64::MIN_POSITIVE));
+        self.last = Some(mean);
+        Ok(if steady {
+            Flow::Stop(format!(
+                "steady: the mean liquid speed changed by less than {:e} at step {}",
+                self.tol,
+                m.steps_done()
+            ))
+        } else {
+            Flow::Continue
+        })
+    }
+    fn save(&self) -> serde_json::Value {
+        serde_json::json!(self.last)
+    }
+    fn restore(&mut self, v: serde_json::Value) -> Result<()> {
+        self.last = serde_json::from_value(v)?;
+        Ok(())
+    }
+}
+
+/// Stop when wall `wall` has moved `distance` (m) from where it started.
+pub struct WallMoved {
+    pub wall: usize,
+    pub distance: f64,
+    pub trigger: Trigger,
+}
+
+impl Observer for WallMoved {
+    fn name(&self) -> &'static str {
+        "until_wall_moved"
+    }
+    fn trigger(&self) -> &Trigger {
+        &self.trigger
+    }
+    fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
+        Ok(match m.probe(Probe::WallDisplacement(self.wall)) {
+            Some(d) if d >= self.distance => Flow::Stop(format!(
+                "wall {} moved {d:e} m (>= {:e}) at step {}",
+                self.wall,
+                self.distance,
+                m.steps_done()
+            )),
+            _ => Flow::Continue,
+        })
+    }
+}
+
+/// Interrupt the run (with a checkpoint) after `seconds` of wall-clock time in this process.
+pub struct WallClock {
+    pub seconds: f64,
+    pub start: Instant,
+    pub trigger: Trigger,
+}
+
+impl Observer for WallClock {
+    fn name(&self) -> &'static str {
+        "wall_clock"
+    }
+    fn trigger(&self) -> &Trigger {
+        &self.trigger
+    }
+    fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
+        Ok(if self.start.elapsed().as_secs_f64() >= self.seconds {
+            Flow::Interrupt(format!(
+                "stopped by the wall-clock limit [run] wall_clock = {} s at step {}",
+                self.seconds,
+                m.steps_done()
+            ))
+        } else {
+            Flow::Continue
+        })
+    }
+}

@@ -1,0 +1,44 @@
+//! `[coupling]`: how the liquid and the grains see each other (Su et al. 2020 Sect. 2.3).
+
+use lbdem_coupling::Method;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CouplingSection {
+    /// "psm" (partially saturated cells, default) or "bounce-back".
+    #[serde(default)]
+    pub method: Method,
+    /// Hydrodynamic radius factor for the LBM step only (Su Sect. 2.3: 0.8).
+    #[serde(default = "r_hd")]
+    pub r_hd: f64,
+    /// Sample depth (m) that the particle density is per (kg/m² = ρ_S × depth).
+    #[serde(default = "one")]
+    pub depth: f64,
+    /// Membrane grains do not feel the liquid.
+    #[serde(default)]
+    pub dry_membrane: bool,
+    /// PSM only: give the grains back the inertia of the liquid PSM carries inside them
+    /// (Uhlmann 2005); refused unless every grain is at least 1.2 times denser than the liquid.
+    #[serde(default)]
+    pub interior_liquid_correction: bool,
+}
+
+impl Default for CouplingSection {
+    fn default() -> Self {
+        Self {
+            method: Method::Psm,
+            r_hd: r_hd(),
+            depth: 1.0,
+            dry_membrane: false,
+            interior_liquid_correction: false,
+        }
+    }
+}
+
+fn r_hd() -> f64 {
+    0.8
+}
+fn one() -> f64 {
+    1.0
+}

@@ -1,0 +1,155 @@
+//! Sections of the grains: `[particles]`, `[contact]`/`[wall_contact]` (the laws of
+//! `lbdem_dem::Law`), `[[walls]]`, `[bonds]`, `[membrane]`, `[dem]` (the DEM time step) and
+//! `[compress]` (isotropic compression before the run, Su et al. 2020 Sect. 2.4).
+
+use lbdem_dem::contact::BondParams;
+use lbdem_dem::generate::Compression;
+use lbdem_dem::{StepParams, Vec2};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// `[particles]`: the grains, from the digitise stage's circle file or generated.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticlesSection {
+    /// Density (kg/m² per unit thickness, i.e. ρ_s × 1 m; ρ_s × depth in coupled scenes).
+    pub density: f64,
+    /// Circles from the digitise stage: CSV with grain_id,x,y,r (+ JSON header beside it).
+    #[serde(default)]
+    pub csv: Option<PathBuf>,
+    #[serde(default)]
+    pub generate: Option<GenerateSection>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct GenerateSection {
+    pub count: usize,
+    /// Templates: each a list of circles [x, y, r] (m) and a weight.
+    pub templates: Vec<TemplateSection>,
+    pub lo: [f64; 2],
+    pub hi: [f64; 2],
+    #[serde(default)]
+    pub seed: u64,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemplateSection {
+    pub circles: Vec<[f64; 3]>,
+    #[serde(default = "one")]
+    pub weight: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// One entry of `[[walls]]`: `box = [x0, y0, x1, y1]` (four planes), a plane (`p`, `n`) or a
+/// segment (`a`, `b`), with an optional prescribed velocity (m/s), e.g. the push-plate.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSection {
+    #[serde(default, rename = "box")]
+    pub box_: Option<[f64; 4]>,
+    #[serde(default)]
+    pub p: Option<[f64; 2]>,
+    #[serde(default)]
+    pub n: Option<[f64; 2]>,
+    #[serde(default)]
+    pub a: Option<[f64; 2]>,
+    #[serde(default)]
+    pub b: Option<[f64; 2]>,
+    #[serde(default)]
+    pub velocity: Option<[f64; 2]>,
+}
+
+/// `[bonds]`: parallel bonds between membrane circles closer than r_i + r_j + gap.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BondsSection {
+    pub params: BondParams,
+    pub gap: f64,
+}
+
+/// `[membrane]`: grains within `shell` of the assembly's outline become membrane grains, pushed
+/// back with `force` when they move outward by more than `threshold` (Su Sect. 2.4).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MembraneSection {
+    pub shell: f64,
+    pub threshold: f64,
+    pub force: f64,
+}
+
+/// `[dem]`: the DEM time step and what acts on every grain.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DemSection {
+    /// DEM time step Δt (s); refused above the critical step.
+    pub dt: f64,
+    /// Verlet-list skin (m).
+    pub skin: f64,
+    /// Gravity (m/s²), [x, y].
+    #[serde(default)]
+    pub gravity: [f64; 2],
+    /// Factor on gravity: 1 for dry grains, 1 − ρ_L/ρ_S for buoyant grains (Su Sect. 2.4).
+    #[serde(default = "one")]
+    pub gravity_factor: f64,
+    /// Viscous damping rate γ (1/s): F −= γ m v, T −= γ I ω.
+    #[serde(default)]
+    pub viscous_damping: f64,
+    /// Local (non-viscous, Cundall) damping α: F_k −= α |F_k| sign(v_k).
+    #[serde(default)]
+    pub local_damping: f64,
+}
+
+impl DemSection {
+    pub fn step_params(&self) -> StepParams {
+        StepParams {
+            dt: self.dt,
+            gravity: Vec2::new(self.gravity[0], self.gravity[1]),
+            gravity_factor: self.gravity_factor,
+            viscous_damping: self.viscous_damping,
+            local_damping: self.local_damping,
+            skin: self.skin,
+        }
+    }
+}
+
+/// `[compress]`: isotropic compression by four servo walls to a 2D stress before the run,
+/// then optionally a radius scaling to a target packing fraction (Su Sect. 2.4).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompressSection {
+    pub target_stress: f64,
+    #[serde(default = "alpha")]
+    pub alpha: f64,
+    pub v_max: f64,
+    #[serde(default = "tol")]
+    pub tolerance: f64,
+    pub v_threshold: f64,
+    pub max_steps: u64,
+    #[serde(default)]
+    pub target_packing: Option<f64>,
+}
+
+fn alpha() -> f64 {
+    0.1
+}
+fn tol() -> f64 {
+    0.05
+}
+
+impl CompressSection {
+    pub fn to_kernel(&self) -> Compression {
+        Compression {
+            target_stress: self.target_stress,
+            alpha: self.alpha,
+            v_max: self.v_max,
+            tolerance: self.tolerance,
+            v_threshold: self.v_threshold,
+            max_steps: self.max_steps,
+        }
+    }
+}

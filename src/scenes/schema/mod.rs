@@ -1,0 +1,370 @@
+//! The scene file: a set of sections, one type each, shared by every scene. What a scene
+//! simulates follows from the sections it has: `[particles]` alone is a dry DEM run, `[fluid]`
+//! with `[lattice]` alone a liquid run, both together a coupled LBM-DEM run. A section that the
+//! scene's physics does not use is refused ("[lattice] is given but the scene has no [fluid]"),
+//! so nothing is silently ignored. New physics is a new section here, not a new scene kind.
+//!
+//! Every section refuses unknown keys, and the error names the file, the line, the key and the
+//! nearest valid name. Files of the earlier format (`[scene] kind = ...`, `[step]`, `[stop]`)
+//! get an error that says how to convert them. Format: docs/scenes.md.
+
+mod coupling;
+mod dem;
+mod fluid;
+mod legacy;
+mod run;
+
+pub use coupling::CouplingSection;
+pub use dem::{
+    BondsSection, CompressSection, DemSection, GenerateSection, MembraneSection, ParticlesSection,
+    TemplateSection, WallSection,
+};
+pub use fluid::{
+    BoundariesSection, FaceSection, FluidSection, ForcingSection, LatticeSection, MaskSection,
+    ObstacleSection,
+};
+pub use run::{OutputSection, RunSection, TriggerSpec, WallMoved};
+
+use anyhow::{Context, Result, bail};
+use lbdem_dem::Law;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// `[scene]`: the name (default: the file's stem) and a free description.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Header {
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub description: Option<String>,
+}
+
+/// `[domain]`: the box (m), 2 or 3 entries per key, and which axes are periodic (for the grains
+/// and the lattice alike).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DomainSection {
+    pub lo: Vec<f64>,
+    pub hi: Vec<f64>,
+    #[serde(default)]
+    pub periodic: Vec<bool>,
+}
+
+impl DomainSection {
+    pub fn dim(&self) -> usize {
+        self.lo.len()
+    }
+    /// Whether axis `a` is periodic.
+    pub fn is_periodic(&self, a: usize) -> bool {
+        self.periodic.get(a).copied().unwrap_or(false)
+    }
+    pub fn size(&self, a: usize) -> f64 {
+        self.hi[a] - self.lo[a]
+    }
+    /// The 2D box of the grains.
+    pub fn lo2(&self) -> [f64; 2] {
+        [self.lo[0], self.lo[1]]
+    }
+    pub fn hi2(&self) -> [f64; 2] {
+        [self.hi[0], self.hi[1]]
+    }
+    pub fn periodic2(&self) -> [bool; 2] {
+        [self.is_periodic(0), self.is_periodic(1)]
+    }
+}
+
+/// A scene file, parsed.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    #[serde(default)]
+    pub scene: Header,
+    pub domain: DomainSection,
+    #[serde(default)]
+    pub particles: Option<ParticlesSection>,
+    #[serde(default)]
+    pub contact: Option<Law>,
+    #[serde(default)]
+    pub wall_contact: Option<Law>,
+    #[serde(default)]
+    pub walls: Vec<WallSection>,
+    #[serde(default)]
+    pub bonds: Option<BondsSection>,
+    #[serde(default)]
+    pub membrane: Option<MembraneSection>,
+    #[serde(default)]
+    pub dem: Option<DemSection>,
+    #[serde(default)]
+    pub compress: Option<CompressSection>,
+    #[serde(default)]
+    pub fluid: Option<FluidSection>,
+    #[serde(default)]
+    pub lattice: Option<LatticeSection>,
+    #[serde(default)]
+    pub boundaries: Option<BoundariesSection>,
+    #[serde(default)]
+    pub forcing: Option<ForcingSection>,
+    #[serde(default)]
+    pub obstacles: Vec<ObstacleSection>,
+    #[serde(default)]
+    pub mask: Option<MaskSection>,
+    #[serde(default)]
+    pub coupling: Option<CouplingSection>,
+    pub run: RunSection,
+    #[serde(default)]
+    pub output: OutputSection,
+}
+
+/// What a scene simulates, from its sections.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Physics {
+    /// Grains only (DEM).
+    Dry,
+    /// Liquid only (LBM).
+    Fluid,
+    /// Grains in a liquid (LBM-DEM).
+    Coupled,
+}
+
+#[derive(Debug)]
+/// A scene read from its file: the sections, the physics they name, where relative paths
+/// resolve from, and the scene's name.
+pub struct Loaded {
+    pub scene: Scene,
+    pub physics: Physics,
+    pub base_dir: PathBuf,
+    pub name: String,
+    pub path: PathBuf,
+}
+
+/// Read and check the scene file at `path`, with `overrides` (a TOML table of sections and
+/// keys, e.g. from `--set run.steps=100`) merged over it.
+pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read scene file {}", path.display()))?;
+    let mut value: toml::Table =
+        toml::from_str(&text).with_context(|| format!("scene file {} is not valid TOML", path.display()))?;
+    legacy::refuse_old_format(&value, path)?;
+    merge(&mut value, overrides);
+    // Parse from text so that errors point at the line (overrides are re-serialised).
+    let text = if overrides.is_empty() {
+        text
+    } else {
+        toml::to_string(&value)?
+    };
+    let scene: Scene = toml::from_str(&text).map_err(|e| explain(e, path))?;
+    let physics = scene
+        .physics()
+        .with_context(|| format!("scene file {}", path.display()))?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    Ok(Loaded {
+        name: scene.scene.name.clone().unwrap_or(stem),
+        physics,
+        base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        path: path.to_path_buf(),
+        scene,
+    })
+}
+
+/// The scene's name (`[scene] name`, else the file's stem), without checking the rest.
+pub fn scene_name(path: &Path) -> Result<String> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read scene file {}", path.display()))?;
+    let value: toml::Table =
+        toml::from_str(&text).with_context(|| format!("scene file {} is not valid TOML", path.display()))?;
+    let name = value
+        .get("scene")
+        .and_then(|s| s.get("name"))
+        .and_then(|n| n.as_str())
+        .map(str::to_string);
+    Ok(name.unwrap_or_else(|| {
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into())
+    }))
+}
+
+/// Merge `over` into `base`, table by table.
+fn merge(base: &mut toml::Table, over: &toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            _ => {
+                base.insert(k.clone(), v.clone());
+            }
+        }
+    }
+}
+
+/// A parse error with the file name and, for an unknown key, the nearest valid name.
+fn explain(e: toml::de::Error, path: &Path) -> anyhow::Error {
+    let msg = e.to_string();
+    let hint = suggestion(&msg).map_or(String::new(), |(bad, good)| {
+        format!("\n`{bad}` is not a key here; did you mean `{good}`?")
+    });
+    anyhow::anyhow!(
+        "scene file {}: {msg}{hint}\n(every key: docs/scenes.md)",
+        path.display()
+    )
+}
+
+/// From serde's "unknown field `x`, expected one of `a`, `b`" (or "expected `a` or `b`", or
+/// "unknown variant"), the bad key and the valid one nearest to it.
+fn suggestion(msg: &str) -> Option<(String, String)> {
+    let start = msg
+        .find("unknown field `")
+        .map(|i| i + 15)
+        .or_else(|| msg.find("unknown variant `").map(|i| i + 17))?;
+    let bad_end = msg[start..].find('`')? + start;
+    let bad = &msg[start..bad_end];
+    let rest = &msg[bad_end..];
+    let candidates: Vec<&str> = rest.split('`').skip(2).step_by(2).collect();
+    let best = candidates
+        .iter()
+        .map(|c| (strsim::damerau_levenshtein(bad, c), *c))
+        .min()?;
+    (best.0 <= bad.len().max(3) / 2 + 1).then(|| (bad.to_string(), best.1.to_string()))
+}
+
+impl Scene {
+    /// What the scene simulates, checking that every section it has is used by that physics.
+    pub fn physics(&self) -> Result<Physics> {
+        let d = &self.domain;
+        if !(d.lo.len() == 2 || d.lo.len() == 3) || d.hi.len() != d.lo.len() {
+            bail!(
+                "[domain] lo and hi need 2 (2D) or 3 (3D) numbers each; got {} and {}",
+                d.lo.len(),
+                d.hi.len()
+            );
+        }
+        if !d.periodic.is_empty() && d.periodic.len() != d.lo.len() {
+            bail!(
+                "[domain] periodic has {} entries for a {}D box; give one true/false per axis",
+                d.periodic.len(),
+                d.lo.len()
+            );
+        }
+        for a in 0..d.dim() {
+            if d.hi[a] <= d.lo[a] || !d.lo[a].is_finite() || !d.hi[a].is_finite() {
+                bail!(
+                    "[domain] axis {a}: hi = {} must be above lo = {}",
+                    d.hi[a],
+                    d.lo[a]
+                );
+            }
+        }
+        let grains = self.particles.is_some();
+        let liquid = self.fluid.is_some();
+        if self.lattice.is_some() && !liquid {
+            bail!("[lattice] is given but the scene has no [fluid]; add [fluid] or remove [lattice]");
+        }
+        if liquid && self.lattice.is_none() {
+            bail!("[fluid] needs a [lattice] section (dx and dt or tau)");
+        }
+        let grain_only: [(&str, bool); 7] = [
+            ("[contact]", self.contact.is_some()),
+            ("[wall_contact]", self.wall_contact.is_some()),
+            ("[[walls]]", !self.walls.is_empty()),
+            ("[bonds]", self.bonds.is_some()),
+            ("[membrane]", self.membrane.is_some()),
+            ("[dem]", self.dem.is_some()),
+            ("[compress]", self.compress.is_some()),
+        ];
+        let liquid_only: [(&str, bool); 2] = [
+            ("[boundaries]", self.boundaries.is_some()),
+            ("[forcing]", self.forcing.is_some()),
+        ];
+        if !grains {
+            if let Some((s, _)) = grain_only.iter().find(|(_, on)| *on) {
+                bail!("{s} is given but the scene has no [particles]; add [particles] or remove {s}");
+            }
+            if self.run.until_slower_than.is_some() || self.run.until_wall_moved.is_some() {
+                bail!("[run] until_slower_than / until_wall_moved need grains ([particles])");
+            }
+        }
+        if !liquid {
+            if let Some((s, _)) = liquid_only.iter().find(|(_, on)| *on) {
+                bail!("{s} is given but the scene has no [fluid]; add [fluid] and [lattice] or remove {s}");
+            }
+            if self.run.until_steady.is_some() {
+                bail!("[run] until_steady needs a liquid ([fluid])");
+            }
+        }
+        if self.coupling.is_some() && !(grains && liquid) {
+            bail!("[coupling] is given but the scene does not have both [particles] and [fluid]");
+        }
+        let physics = match (grains, liquid) {
+            (true, false) => Physics::Dry,
+            (false, true) => Physics::Fluid,
+            (true, true) => Physics::Coupled,
+            (false, false) => {
+                bail!("the scene has neither [particles] nor [fluid]: nothing to simulate (docs/scenes.md)")
+            }
+        };
+        if grains {
+            if self.contact.is_none() {
+                bail!("[particles] needs a [contact] law (law = \"linear\", \"hertz\" or \"plastic\")");
+            }
+            if self.dem.is_none() {
+                bail!("[particles] needs a [dem] section (dt, skin)");
+            }
+            if d.dim() != 2 {
+                bail!("[particles]: the grains are 2D; give [domain] lo and hi with 2 numbers");
+            }
+        }
+        if physics != Physics::Fluid && (!self.obstacles.is_empty() || self.mask.is_some()) {
+            bail!("[[obstacles]] and [mask] are for liquid-only scenes; the grains are the solids here");
+        }
+        if self.bonds.is_some() && self.membrane.is_none() {
+            bail!("[bonds] bond the membrane grains: add a [membrane] section");
+        }
+        match (self.run.steps, self.run.time) {
+            (Some(0), _) => bail!("[run] steps = 0: give at least 1"),
+            (Some(_), None) => {}
+            (None, Some(t)) if t > 0.0 && t.is_finite() => {}
+            (None, Some(t)) => bail!("[run] time = {t}: give a positive number of seconds"),
+            _ => bail!("[run]: give exactly one of steps or time (s)"),
+        }
+        for (what, t) in [
+            ("series", &self.output.series),
+            ("snapshots", &self.output.snapshots),
+            ("checkpoints", &self.output.checkpoints),
+        ] {
+            check_trigger(what, t)?;
+        }
+        if self.output.series.wall_seconds.is_some() || self.output.snapshots.wall_seconds.is_some() {
+            bail!(
+                "[output]: wall_seconds is for checkpoints only (series and snapshots must not depend on the machine's speed)"
+            );
+        }
+        Ok(physics)
+    }
+}
+
+fn check_trigger(what: &str, t: &TriggerSpec) -> Result<()> {
+    let given = usize::from(t.every.is_some())
+        + usize::from(t.count.is_some())
+        + usize::from(t.at.is_some())
+        + usize::from(t.wall_seconds.is_some())
+        + usize::from(t.never);
+    if given != 1 {
+        bail!(
+            "[output] {what}: give exactly one of every = N (steps), count = N, at = [times in s], \
+             wall_seconds = S or never = true"
+        );
+    }
+    if t.every == Some(0) || t.count == Some(0) {
+        bail!("[output] {what}: every / count must be at least 1 (use never = true to switch it off)");
+    }
+    if let Some(s) = t.wall_seconds
+        && !(s > 0.0 && s.is_finite())
+    {
+        bail!("[output] {what}: wall_seconds = {s} must be a positive number of seconds");
+    }
+    Ok(())
+}

@@ -1,0 +1,112 @@
+//! `[run]` (how long, when to stop) and `[output]` (what to write, when): the time loop's
+//! stop conditions and the triggers of its observers (`crate::scenes::timeloop`).
+
+use serde::{Deserialize, Serialize};
+
+/// `[run]`. A step is the scene's outer step: one DEM step (grains only), one LBM step
+/// (liquid only), or one LBM step with its DEM sub-steps (coupled).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSection {
+    /// Number of steps; give this or `time`.
+    #[serde(default)]
+    pub steps: Option<u64>,
+    /// Simulated time (s).
+    #[serde(default)]
+    pub time: Option<f64>,
+    /// Stop when every grain is slower than this (m/s), checked at every series sample.
+    #[serde(default)]
+    pub until_slower_than: Option<f64>,
+    /// Stop when the mean liquid speed changes by less than this fraction between series samples.
+    #[serde(default)]
+    pub until_steady: Option<f64>,
+    /// Stop when a wall has moved this far from where it started.
+    #[serde(default)]
+    pub until_wall_moved: Option<WallMoved>,
+    /// Wall-clock limit (s): the run stops with a checkpoint, to be continued with `--resume`.
+    #[serde(default)]
+    pub wall_clock: Option<f64>,
+    /// rayon threads (0 = all cores). Results do not depend on it.
+    #[serde(default)]
+    pub threads: usize,
+}
+
+/// `until_wall_moved = { wall = 0, distance = 1e-3 }`: wall index in `[[walls]]` order (a box
+/// counts as four walls: left, right, bottom, top).
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallMoved {
+    pub wall: usize,
+    pub distance: f64,
+}
+
+/// `[output]`: when the series, snapshots and checkpoints are written.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSection {
+    /// One row of the time series (`series.csv`); the last step always gets one.
+    #[serde(default = "series")]
+    pub series: TriggerSpec,
+    /// Particle and fluid snapshots (tables that can be read back, and VTK); the last step
+    /// always gets one.
+    #[serde(default = "snapshots")]
+    pub snapshots: TriggerSpec,
+    /// Checkpoints for `--resume`.
+    #[serde(default = "checkpoints")]
+    pub checkpoints: TriggerSpec,
+    /// Pressure-change threshold (Pa) of the "area below" statistic of coupled scenes (Su
+    /// Sect. 2.5, Eq. 19).
+    #[serde(default = "threshold")]
+    pub pressure_threshold: f64,
+}
+
+impl Default for OutputSection {
+    fn default() -> Self {
+        Self {
+            series: series(),
+            snapshots: snapshots(),
+            checkpoints: checkpoints(),
+            pressure_threshold: threshold(),
+        }
+    }
+}
+
+fn series() -> TriggerSpec {
+    TriggerSpec {
+        count: Some(200),
+        ..Default::default()
+    }
+}
+fn snapshots() -> TriggerSpec {
+    TriggerSpec {
+        count: Some(4),
+        ..Default::default()
+    }
+}
+fn checkpoints() -> TriggerSpec {
+    TriggerSpec {
+        wall_seconds: Some(600.0),
+        ..Default::default()
+    }
+}
+fn threshold() -> f64 {
+    -1000.0
+}
+
+/// When an observer acts; exactly one key: `{ every = 100 }` steps, `{ count = 20 }` times
+/// spread evenly over the run, `{ at = [0.1, 0.2] }` simulated seconds, `{ wall_seconds = 600 }`
+/// of wall-clock time (checkpoints only), or `{ never = true }`.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TriggerSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub every: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_seconds: Option<f64>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub never: bool,
+}

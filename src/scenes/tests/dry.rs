@@ -1,0 +1,146 @@
+//! Grains only.
+
+use super::*;
+
+pub(super) const SCENE: &str = r#"
+[domain]
+lo = [0.0, 0.0]
+hi = [0.01, 0.01]
+[particles]
+density = 2.6
+[particles.generate]
+count = 60
+lo = [0.0, 0.0]
+hi = [0.01, 0.01]
+seed = 3
+templates = [ { circles = [[0.0, 0.0, 3.0e-4], [2.5e-4, 0.0, 2.5e-4]] } ]
+[[walls]]
+box = [0.0, 0.0, 0.01, 0.01]
+[contact]
+law = "linear"
+k_n = 1000.0
+k_t = 500.0
+damping = { ratio = 0.3 }
+mu = 0.5
+rolling = { k_r = 1.0e-5, mu_r = 0.1 }
+[dem]
+dt = 4.0e-6
+skin = 5.0e-5
+gravity = [0.0, -9.81]
+[run]
+steps = 3000
+[output]
+series = { every = 100 }
+snapshots = { every = 1000 }
+checkpoints = { every = 1000 }
+"#;
+
+/// A run interrupted (wall-clock limit, then more interruptions on every resume) and resumed
+/// until done ends bit for bit like the uninterrupted run: the series, and every snapshot's
+/// particle and contact tables.
+#[test]
+fn interrupted_and_resumed_run_matches_uninterrupted_bitwise() {
+    let t = tempfile::tempdir().unwrap();
+    let whole = simulate(SCENE, &t.path().join("whole"), false).unwrap();
+    assert_eq!(whole.output.summary["steps"], 3000);
+    let limited = SCENE.replace("steps = 3000", "steps = 3000\nwall_clock = 0.01");
+    let dir = t.path().join("cut");
+    let mut resume = false;
+    let mut interruptions = 0;
+    loop {
+        match simulate(&limited, &dir, resume) {
+            Ok(_) => break,
+            Err(e) => {
+                let msg = format!("{e:#}");
+                assert!(msg.contains("--resume"), "{msg}");
+                assert!(
+                    dir.join("out/.partial/checkpoint.json").is_file(),
+                    "no checkpoint kept: {msg}"
+                );
+                interruptions += 1;
+                resume = true;
+                assert!(interruptions < 3000, "never finished");
+            }
+        }
+    }
+    assert!(
+        interruptions >= 1,
+        "the wall-clock limit never interrupted the run"
+    );
+    let (a, b) = (t.path().join("whole/out"), dir.join("out"));
+    for f in
+        ["series.csv", "snapshots.csv"]
+            .into_iter()
+            .map(PathBuf::from)
+            .chain(["particles", "contacts"].iter().flat_map(|k| {
+                [1000u64, 2000, 3000].map(|s| PathBuf::from(format!("snapshots/{k}_{s:09}.csv")))
+            }))
+    {
+        let (x, y) = (
+            std::fs::read(a.join(&f)).unwrap(),
+            std::fs::read(b.join(&f)).unwrap(),
+        );
+        assert!(
+            x == y,
+            "{} differs after {interruptions} interruptions",
+            f.display()
+        );
+    }
+    let p = crate::scenes::snapshot::read_particles(&b.join("snapshots/particles_000003000.csv")).unwrap();
+    assert_eq!(p.circle.len(), 120, "two circles per grain");
+    assert!(p.vy.iter().sum::<f64>() < 0.0, "the grains fall");
+    assert!(!b.join(".partial").exists() && !b.join("checkpoint.json").exists());
+}
+
+/// The particle table reads back to the bits of the state it was written from.
+#[test]
+fn particle_table_reads_back_exactly() {
+    let t = tempfile::tempdir().unwrap();
+    let text = SCENE.replace("steps = 3000", "steps = 200");
+    let l = {
+        std::fs::create_dir_all(t.path().join("s")).unwrap();
+        std::fs::write(t.path().join("s/scene.toml"), &text).unwrap();
+        crate::scenes::schema::load(&t.path().join("s/scene.toml"), &Default::default()).unwrap()
+    };
+    let mut m = crate::scenes::models::dry::Dry::build(&l.scene, &l.base_dir, true).unwrap();
+    use crate::scenes::timeloop::Model;
+    for _ in 0..200 {
+        m.step(false).unwrap();
+    }
+    std::fs::create_dir_all(t.path().join("snapshots")).unwrap();
+    let files = m.snapshot(t.path()).unwrap();
+    let table = crate::scenes::snapshot::read_particles(&t.path().join(&files[0].1)).unwrap();
+    let want = crate::scenes::snapshot::ParticleTable::of(&m.sys);
+    assert_eq!(table, want);
+    assert!(table.vy.iter().any(|v| *v < 0.0), "the grains fall");
+}
+
+#[test]
+fn reads_digitised_circles_in_pixels() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(t.path().join("scene")).unwrap();
+    let csv = t.path().join("scene/grains.csv");
+    std::fs::write(&csv, "grain_id,x,y,r\n0,10,10,4\n0,14,10,3\n1,30,30,5\n").unwrap();
+    std::fs::write(
+        t.path().join("scene/grains.json"),
+        r#"{"units": "px", "pixel_size": 1.0e-5}"#,
+    )
+    .unwrap();
+    let text = SCENE
+        .replace(
+            "[particles.generate]\ncount = 60\nlo = [0.0, 0.0]\nhi = [0.01, 0.01]\nseed = 3\ntemplates = [ { circles = [[0.0, 0.0, 3.0e-4], [2.5e-4, 0.0, 2.5e-4]] } ]",
+            "csv = \"grains.csv\"",
+        )
+        .replace("steps = 3000", "steps = 1");
+    let rec = simulate(&text, t.path(), false).unwrap();
+    assert_eq!(rec.output.summary["engine"]["bodies"], 2);
+    let p = crate::scenes::snapshot::read_particles(&t.path().join("out/snapshots/particles_000000001.csv"))
+        .unwrap();
+    assert_eq!(p.circle.len(), 3);
+    assert!((p.r[2] - 5e-5).abs() < 1e-18);
+    // The second grain is a single disk at (30, 30) px (it has fallen one step since).
+    assert!((p.body_x[2] - 3e-4).abs() < 1e-12 && (p.body_y[2] - 3e-4).abs() < 1e-9);
+    std::fs::write(&csv, "grain_id,x,y\n0,1,1\n").unwrap();
+    let err = format!("{:#}", simulate(&text, t.path(), false).unwrap_err());
+    assert!(err.contains("no column \"r\""), "{err}");
+}

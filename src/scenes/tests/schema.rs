@@ -1,0 +1,102 @@
+//! The scene format: every shipped scene parses and names its physics; typos, sections the
+//! physics does not use and files of the earlier format are refused with a way out.
+
+use super::*;
+use crate::scenes::schema::{Physics, load};
+
+fn load_text(text: &str) -> anyhow::Result<crate::scenes::schema::Loaded> {
+    let t = tempfile::tempdir()?;
+    let p = t.path().join("s.toml");
+    std::fs::write(&p, text)?;
+    load(&p, &Default::default())
+}
+
+#[test]
+fn every_shipped_scene_parses_with_its_physics() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut seen = 0;
+    for e in std::fs::read_dir(&dir).unwrap().flatten() {
+        let p = e.path();
+        if p.extension().is_none_or(|x| x != "toml") {
+            continue;
+        }
+        let l = load(&p, &Default::default()).unwrap_or_else(|e| panic!("{}: {e:#}", p.display()));
+        let name = p.file_name().unwrap().to_string_lossy();
+        let want = match &name[..3] {
+            "dry" => Physics::Dry,
+            "flu" => Physics::Fluid,
+            _ => Physics::Coupled,
+        };
+        assert_eq!(l.physics, want, "{name}");
+        seen += 1;
+    }
+    assert_eq!(seen, 7);
+}
+
+#[test]
+fn a_typo_names_the_file_the_line_and_the_nearest_key() {
+    let text = super::dry::SCENE.replace("skin = 5.0e-5", "skni = 5.0e-5");
+    let e = format!("{:#}", load_text(&text).unwrap_err());
+    assert!(
+        e.contains("s.toml") && e.contains("skni") && e.contains("did you mean `skin`"),
+        "{e}"
+    );
+    assert!(e.contains("line"), "{e}");
+    let text = super::dry::SCENE.replace("[output]", "[outptu]");
+    let e = format!("{:#}", load_text(&text).unwrap_err());
+    assert!(e.contains("did you mean `output`"), "{e}");
+}
+
+#[test]
+fn sections_the_physics_does_not_use_are_refused() {
+    let text = format!("{}\n[lattice]\ndx = 1e-4\ntau = 0.8\n", super::dry::SCENE);
+    let e = format!("{:#}", load_text(&text).unwrap_err());
+    assert!(
+        e.contains("[lattice] is given but the scene has no [fluid]"),
+        "{e}"
+    );
+    let text = format!(
+        "{}\n[[walls]]\nbox = [0.0, 0.0, 1e-3, 1e-3]\n",
+        super::fluid::POISEUILLE
+    );
+    let e = format!("{:#}", load_text(&text).unwrap_err());
+    assert!(
+        e.contains("[[walls]] is given but the scene has no [particles]"),
+        "{e}"
+    );
+    let text = super::fluid::POISEUILLE.replace(
+        "periodic = [true, false]",
+        "periodic = [true, false]\n[boundaries]\nx_min = { type = \"wall\" }",
+    );
+    let t = tempfile::tempdir().unwrap();
+    let e = format!("{:#}", simulate(&text, t.path(), false).unwrap_err());
+    assert!(e.contains("x_min") && e.contains("periodic"), "{e}");
+    assert!(!t.path().join("out").exists());
+}
+
+#[test]
+fn an_old_style_file_is_refused_with_how_to_convert_it() {
+    let old = "[scene]\nkind = \"dry\"\n[domain]\nlo = [0.0, 0.0]\nhi = [1.0, 1.0]\n[step]\ndt = 1e-6\nskin = 1e-5\n\
+               [run]\nsteps = 10\noutput_every = 5\n";
+    let e = format!("{:#}", load_text(old).unwrap_err());
+    assert!(e.contains("earlier format"), "{e}");
+    assert!(
+        e.contains("remove [scene] kind") && e.contains("rename [step] to [dem]"),
+        "{e}"
+    );
+    assert!(e.contains("series = { every = N }"), "{e}");
+}
+
+#[test]
+fn overrides_reach_into_sections() {
+    let t = tempfile::tempdir().unwrap();
+    let p = t.path().join("s.toml");
+    std::fs::write(&p, super::dry::SCENE).unwrap();
+    let over: toml::Table = toml::from_str("run = { steps = 7 }\ndem = { dt = 2e-6 }").unwrap();
+    let l = load(&p, &over).unwrap();
+    assert_eq!(l.scene.run.steps, Some(7));
+    assert_eq!(l.scene.dem.unwrap().dt, 2e-6);
+    let bad: toml::Table = toml::from_str("run = { stpes = 7 }").unwrap();
+    let e = format!("{:#}", load(&p, &bad).unwrap_err());
+    assert!(e.contains("did you mean `steps`"), "{e}");
+}
