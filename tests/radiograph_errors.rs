@@ -3,7 +3,7 @@
 use lbdem::contract::{Stage, StageContext};
 use lbdem::io::tiff::{write_u8, write_u16};
 use lbdem::stages::radiograph::{Params, Radiograph};
-use lbdem_imaging::tiff::encoder::{TiffEncoder, colortype};
+use tiff::encoder::{TiffEncoder, colortype};
 use ndarray::Array2;
 use std::path::Path;
 

@@ -2,9 +2,9 @@
 //! it marks masked pixels); writing encodes in memory and then writes atomically.
 
 use anyhow::{Context, Result, bail};
-use lbdem_imaging::tiff::ColorType;
-use lbdem_imaging::tiff::decoder::{Decoder, DecodingResult, Limits};
-use lbdem_imaging::tiff::encoder::{Compression, DeflateLevel, TiffEncoder, colortype};
+use tiff::ColorType;
+use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::encoder::{Compression, DeflateLevel, TiffEncoder, colortype};
 use ndarray::{Array2, ArrayView2};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
@@ -15,7 +15,7 @@ pub struct Frame {
     /// `file` for a single image, `file#page` inside a stack (page from 0).
     pub label: String,
     pub data: Array2<f64>,
-    /// Bits per sample of the source (8, 16 or 32).
+    /// Bits per sample of the source (8, 16, 32 or 64).
     pub bits: u8,
 }
 
@@ -45,7 +45,7 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
             .colortype()
             .with_context(|| format!("{label}: cannot read the pixel type"))?;
         let bits = match ct {
-            ColorType::Gray(b @ (8 | 16 | 32)) => b,
+            ColorType::Gray(b @ (8 | 16 | 32 | 64)) => b,
             other => bail!(
                 "{label}: unsupported pixel type {other:?}; lbdem reads single-channel (grey) TIFF with \
                  8- or 16-bit unsigned integer or 32-bit float samples: convert the file (e.g. with \

@@ -34,8 +34,4 @@ pub use measure::GrainMeasure;
 pub use segment::{Digitised, Params, digitise};
 pub use twocircle::{Fit, FitCircle};
 
-/// Re-exported for the root crate's reader of 32-bit float TIFF (solid-fraction maps),
-/// which the `image` crate does not decode; kernels never do I/O.
-pub use tiff;
-
 pub type Result<T> = std::result::Result<T, GrainsError>;

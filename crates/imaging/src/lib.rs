@@ -4,8 +4,7 @@
 //! corrections, and the forward model that makes synthetic radiographs with a known answer.
 //!
 //! Pure computation on `ndarray` fields indexed `[row, col]` = `[y, x]`: no file I/O here
-//! (TIFF reading and writing live in the root crate's `io` module, which uses the `tiff`
-//! re-export below so that both agree on one version).
+//! (TIFF reading and writing live in the root crate's `io::tiff`, the one TIFF reader).
 
 pub mod beer_lambert;
 pub mod correct;
@@ -18,6 +17,5 @@ pub mod synth;
 pub use error::ImagingError;
 pub use roi::Roi;
 /// Re-exported for the root crate's TIFF reader/writer (kernels never do I/O).
-pub use tiff;
 
 pub type Result<T> = std::result::Result<T, ImagingError>;

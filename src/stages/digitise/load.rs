@@ -1,6 +1,6 @@
 //! Reading the image digitise works on: a 32- or 64-bit float TIFF (the radiograph
-//! stage's solid-fraction map, values 0..1, NaN outside the sample) through the `tiff`
-//! crate, anything else (PNG, JPEG, 8/16-bit TIFF) through `image`, reduced to one grey
+//! stage's solid-fraction map, values 0..1, NaN outside the sample) through the one TIFF
+//! reader (`crate::io::tiff`), anything else (PNG, JPEG, 8/16-bit TIFF) through `image`, reduced to one grey
 //! channel in f64.
 
 use anyhow::{Context, Result, bail};
@@ -37,8 +37,7 @@ pub fn load(path: &Path, channel: Channel) -> Result<Loaded> {
     }
     let is_tiff = bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*");
     if is_tiff
-        && let Some(l) =
-            load_float_tiff(&bytes).with_context(|| format!("reading TIFF {}", path.display()))?
+        && let Some(l) = load_float_tiff(path)?
     {
         return Ok(l);
     }
@@ -77,26 +76,17 @@ fn pick(p: [f64; 3], channel: Channel) -> f64 {
     }
 }
 
-/// A one-sample float TIFF, or `None` for any other TIFF (left to `image`).
-fn load_float_tiff(bytes: &[u8]) -> Result<Option<Loaded>> {
-    use lbdem_grains::tiff::ColorType;
-    use lbdem_grains::tiff::decoder::{Decoder, DecodingResult};
-    let mut dec = Decoder::new(std::io::Cursor::new(bytes))?;
-    let (w, h) = dec.dimensions()?;
-    if !matches!(dec.colortype()?, ColorType::Gray(32) | ColorType::Gray(64)) {
+/// A one-sample float TIFF (through the one TIFF reader, `crate::io::tiff`), or `None` for
+/// any other TIFF (left to `image`, which also reads colour).
+fn load_float_tiff(path: &Path) -> Result<Option<Loaded>> {
+    let Ok(mut frames) = crate::io::tiff::read_pages(path) else {
+        return Ok(None);
+    };
+    if frames.is_empty() || !matches!(frames[0].bits, 32 | 64) {
         return Ok(None);
     }
-    let values: Vec<f64> = match dec.read_image()? {
-        DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
-        DecodingResult::F64(v) => v,
-        _ => return Ok(None),
-    };
-    let (w, h) = (w as usize, h as usize);
-    if values.len() != w * h {
-        bail!("float TIFF holds {} samples for {w} x {h} pixels", values.len());
-    }
     Ok(Some(Loaded {
-        grey: Array2::from_shape_vec((h, w), values)?,
+        grey: frames.swap_remove(0).data,
         kind: "float".into(),
     }))
 }
