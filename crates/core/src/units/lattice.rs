@@ -24,6 +24,21 @@ pub enum TimeSpec {
     Tau(f64),
 }
 
+/// Mach number above which a set-up is warned about (Su et al. 2020 Eq. 16, after He et al.):
+/// the one default every scene and stepper refers to.
+pub const MACH_WARN: f64 = 0.1;
+/// Mach number above which a set-up is refused.
+pub const MACH_MAX: f64 = 0.3;
+/// Default cell Reynolds number u_max dx/ν above which a warning is given.
+pub const RE_CELL_WARN: f64 = 10.0;
+/// Default accepted range of a running lattice (`lbdem_lbm::Limits::default`): density within a
+/// factor 2 of the reference 1 ...
+pub const RHO_MIN: f64 = 0.5;
+pub const RHO_MAX: f64 = 2.0;
+/// ... and |u| < 0.4 in lattice units (Ma ≈ 0.69, far beyond any accurate run; Su Eq. 16 asks
+/// Ma < 0.1): beyond it a run is stopped with a diagnosis.
+pub const U_MAX: f64 = 0.4;
+
 /// What a scene states in SI.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LatticeInput {
@@ -54,9 +69,9 @@ impl LatticeInput {
             rho,
             u_max,
             time,
-            mach_warn: 0.1,
-            mach_max: 0.3,
-            re_cell_warn: 10.0,
+            mach_warn: MACH_WARN,
+            mach_max: MACH_MAX,
+            re_cell_warn: RE_CELL_WARN,
         }
     }
 }
