@@ -14,19 +14,10 @@ pub enum CouplingError {
          (Su et al. 2020 Table 3); set dt_dem = dt_lbm / N for a whole N"
     )]
     Ratio { ratio: f64 },
-    #[error(
-        "coupled run unstable at LBM step {step}, node {node:?}: density {rho:.6}, velocity {u:?}; \
-         likely cause: {cause}"
-    )]
-    Unstable {
-        step: u64,
-        node: [usize; 2],
-        rho: f64,
-        u: [f64; 2],
-        cause: String,
-    },
     #[error(transparent)]
     Dem(#[from] lbdem_dem::DemError),
+    /// Every lattice failure, the instability of the PSM lattice included
+    /// (`LbmError::Unstable`: step, node, state and likely cause, from `lbdem_lbm::diagnosis`).
     #[error(transparent)]
     Lbm(#[from] lbdem_lbm::LbmError),
 }

@@ -6,18 +6,23 @@
 //! can be handed to rayon tasks as plain slices; coupled grids are small (Su et al.: about
 //! 250 x 190 nodes) and the step is dominated by the DEM sub-cycles, so clarity wins here over
 //! the structure-of-arrays kernels of `lbdem-lbm`. Populations are stored in `T` (f64 or f32)
-//! and every update is computed in f64.
+//! and every update is computed in f64. The liquid part of the collision is the operator of
+//! `lbdem-lbm` (`lbdem_lbm::Collider`: BGK or TRT, uniform or with per-node τ), so the choice of
+//! collision is made in one place for every lattice.
 //!
 //! Determinism: rows are split into fixed chunks; each chunk writes its own slice of the
 //! population array and of the per-cover force buffer, and the per-grain sums run serially in
 //! cover order, so the result is bitwise the same for any number of threads.
 
 use crate::error::CouplingError;
-use crate::solid_fraction::SolidMap;
+use crate::solid_fraction::{CellCover, SolidMap};
 use crate::weighting::psm_weight;
+use lbdem_lbm::collision::{CollideParams, Collider, LocalRates, NodeRates, local_rates};
+use lbdem_lbm::lattice::QMAX;
 use lbdem_lbm::plan::{Upstream, neighbour};
-use lbdem_lbm::{D2Q9, Domain, Face, Lattice, Limits, Real};
+use lbdem_lbm::{BadNode, Collision, D2Q9, Domain, Face, Lattice, LbmError, Limits, Real};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 const Q: usize = 9;
 /// Rows per rayon task: fixed, so the split is the same for every pool size.
@@ -27,7 +32,7 @@ const WALL: u32 = 1 << 31;
 
 /// Rigid motion of one grain in lattice units: centre (node i has its centre at i + ½),
 /// velocity and angular velocity (counter-clockwise positive).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct GrainMotion {
     pub centre: [f64; 2],
     pub velocity: [f64; 2],
@@ -46,17 +51,18 @@ impl GrainMotion {
 }
 
 /// Hydrodynamic force (x, y) and moment (z) on one grain, lattice units.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Load {
     pub force: [f64; 2],
     pub torque: f64,
 }
 
 /// Collision settings of a PSM lattice.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PsmSettings {
-    /// BGK relaxation time (Su Eq. 15: ν = c_s²(τ − ½)).
-    pub tau: f64,
+    /// The liquid collision (the operator of `lbdem-lbm`): BGK with τ (Su Eq. 15:
+    /// ν = c_s²(τ − ½)), or TRT with τ⁺ = τ and the magic Λ. τ also sets B of Eq. 10.
+    pub collision: Collision,
     /// Uniform body-force density on the liquid (Guo forcing, applied to the share 1 − B of
     /// each node), lattice units.
     pub force: [f64; 2],
@@ -77,13 +83,28 @@ pub struct PsmFluid<T: Real> {
     /// Inactive nodes (outside the sample: the "solid zone" of Su Sect. 2.4) are never updated.
     active: Vec<bool>,
     settings: PsmSettings,
-    /// TRT magic parameter Λ = (τ⁺ − ½)(τ⁻ − ½) of the liquid collision, or `None` for BGK.
-    trt_magic: Option<f64>,
+    /// Uniform collision constants (f64: every update is computed in f64).
+    params: CollideParams<f64>,
+    /// Per-node rates and the τ they came from (`set_local_tau`).
+    local: Option<(Vec<NodeRates<f64>>, Vec<f64>)>,
     /// Density and velocity of every node after the last step.
     pub rho: Vec<f64>,
     pub u: Vec<[f64; 2]>,
     /// Per cover of the last solid map: the load its grain received there.
     cover_load: Vec<Load>,
+    pub step: u64,
+}
+
+/// What a PSM lattice needs besides its domain and settings to continue a run bit for bit
+/// (`PsmFluid::state`, `PsmFluid::restore`): the post-collision populations, the macroscopic
+/// fields of the last step (read by the coupling's outputs), the per-node τ if set, the step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(bound = "")]
+pub struct PsmState<T: Real> {
+    pub f: Vec<T>,
+    pub rho: Vec<f64>,
+    pub u: Vec<[f64; 2]>,
+    pub local_tau: Option<Vec<f64>>,
     pub step: u64,
 }
 
@@ -105,9 +126,12 @@ impl<T: Real> PsmFluid<T> {
                 "the PSM coupling is 2D (D2Q9); the domain has nz = {nz}, set it to 1"
             )));
         }
-        if !(settings.tau > 0.5 && settings.tau.is_finite()) {
-            return Err(CouplingError::Tau { tau: settings.tau });
+        let tau = settings.collision.tau();
+        if !(tau > 0.5 && tau.is_finite()) {
+            return Err(CouplingError::Tau { tau });
         }
+        let params =
+            CollideParams::<f64>::new(&settings.collision, [settings.force[0], settings.force[1], 0.0])?;
         let mut wall_u = vec![[0.0; 2]];
         for face in &domain.faces {
             match face {
@@ -155,7 +179,8 @@ impl<T: Real> PsmFluid<T> {
             wall_u,
             active,
             settings,
-            trt_magic: None,
+            params,
+            local: None,
             rho: vec![1.0; n],
             u: vec![[0.0; 2]; n],
             cover_load: Vec::new(),
@@ -168,15 +193,80 @@ impl<T: Real> PsmFluid<T> {
     /// Λ = (τ − ½)²: near τ = ½ (settling pairs at Reynolds numbers of hundreds) that is about
     /// 1e-4, the odd rate is close to 2 and the odd non-equilibrium flips sign every step and
     /// barely decays; Λ = 1/4 damps it. The solid term (Eq. 11) and the weight B (Eq. 10, from
-    /// τ⁺) are unchanged.
+    /// τ⁺) are unchanged. The same as `PsmSettings::collision = Collision::Trt { tau, magic }`.
     pub fn with_trt(mut self, magic: f64) -> Result<Self, CouplingError> {
-        if !(magic > 0.0 && magic.is_finite()) {
+        let collision = Collision::Trt {
+            tau: self.settings.collision.tau(),
+            magic,
+        };
+        let force = [self.settings.force[0], self.settings.force[1], 0.0];
+        self.params = CollideParams::new(&collision, force)?;
+        self.settings.collision = collision;
+        if let Some((_, tau)) = self.local.take() {
+            self.set_local_tau(tau)?;
+        }
+        Ok(self)
+    }
+
+    /// Relax node x with τ⁺ = `tau[x]` (node order x + nx y) instead of the settings' τ, with the
+    /// settings' kind of collision; B of Eq. 10 then takes the local τ too. The seam of local-τ
+    /// rheology (Bingham, Leonardi et al. 2014 Eq. 8). Equal values everywhere give the uniform
+    /// run bit for bit.
+    pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), CouplingError> {
+        let nodes = self.nx * self.ny;
+        if tau.len() != nodes {
+            return Err(LbmError::LocalTauLength {
+                got: tau.len(),
+                nodes,
+            }
+            .into());
+        }
+        let (rates, bgk) = local_rates::<f64>(&self.settings.collision, &tau)?;
+        self.params.bgk = bgk;
+        self.local = Some((rates, tau));
+        Ok(())
+    }
+
+    /// Back to the settings' uniform τ.
+    pub fn clear_local_tau(&mut self) {
+        self.local = None;
+        let (wp, wm) = (self.params.omega_p, self.params.omega_m);
+        self.params.bgk = wp == wm;
+    }
+
+    /// The state to checkpoint (see [`PsmState`]).
+    pub fn state(&self) -> PsmState<T> {
+        PsmState {
+            f: self.f.clone(),
+            rho: self.rho.clone(),
+            u: self.u.clone(),
+            local_tau: self.local.as_ref().map(|(_, t)| t.clone()),
+            step: self.step,
+        }
+    }
+
+    /// Continue from `state` on a lattice built with the same domain and settings.
+    pub fn restore(&mut self, state: PsmState<T>) -> Result<(), CouplingError> {
+        let n = self.nx * self.ny;
+        if state.f.len() != n * Q || state.rho.len() != n || state.u.len() != n {
             return Err(CouplingError::Unsupported(format!(
-                "TRT magic parameter {magic} must be positive and finite (1/4 is the usual choice)"
+                "PSM state of {} populations and {} nodes for a lattice of {} x {} nodes: restore into \
+                 a lattice built with the checkpoint's domain",
+                state.f.len(),
+                state.rho.len(),
+                self.nx,
+                self.ny
             )));
         }
-        self.trt_magic = Some(magic);
-        Ok(self)
+        match state.local_tau {
+            Some(t) => self.set_local_tau(t)?,
+            None => self.clear_local_tau(),
+        }
+        self.f = state.f;
+        self.rho = state.rho;
+        self.u = state.u;
+        self.step = state.step;
+        Ok(())
     }
 
     /// Set every node to the equilibrium of density `rho` and velocity `u(x, y)`.
@@ -237,21 +327,23 @@ impl<T: Real> PsmFluid<T> {
         self.cover_load.clear();
         self.cover_load.resize(map.covers.len(), Load::default());
 
-        let tau = self.settings.tau;
-        let omega = 1.0 / tau;
-        // Odd-moment rate: equal to ω for BGK, from Λ for TRT.
-        let omega_odd = match self.trt_magic {
-            None => omega,
-            Some(l) => 1.0 / (0.5 + l / (tau - 0.5)),
-        };
-        let trt = self.trt_magic.is_some();
-        let force = self.settings.force;
+        let forced = self.settings.force.iter().any(|&x| x != 0.0);
         let limits = self.settings.limits;
         let step = self.step;
-        let f_in = &self.f;
-        let src = &self.src;
-        let wall_u = &self.wall_u;
-        let active = &self.active;
+        let base = Base {
+            nx,
+            ny,
+            f_in: &self.f,
+            src: &self.src,
+            wall_u: &self.wall_u,
+            active: &self.active,
+            map,
+            start: &start,
+            grains,
+            tau: self.settings.collision.tau(),
+            local_tau: self.local.as_ref().map(|(_, t)| t.as_slice()),
+            limits,
+        };
 
         // Split every per-node and per-cover output into the same fixed row chunks.
         let rows_chunk = ROWS_PER_TASK * nx;
@@ -269,7 +361,13 @@ impl<T: Real> PsmFluid<T> {
                 let (ua, ub) = std::mem::take(&mut u).split_at_mut(len);
                 let nc = (start[node0 + len] - start[node0]) as usize;
                 let (la, lb) = std::mem::take(&mut loads_rest).split_at_mut(nc);
-                tasks.push((node0, fa, ra, ua, la));
+                tasks.push(Chunk {
+                    node0,
+                    f_out: fa,
+                    rho: ra,
+                    u: ua,
+                    loads: la,
+                });
                 f_out = fb;
                 rho = rb;
                 u = ub;
@@ -277,136 +375,24 @@ impl<T: Real> PsmFluid<T> {
                 node0 += len;
             }
         }
-        let bad = tasks
-            .into_par_iter()
-            .map(|(node0, f_out, rho_out, u_out, load_out)| {
-                let c0 = start[node0] as usize;
-                let mut first_bad = None;
-                for k in 0..rho_out.len() {
-                    let idx = node0 + k;
-                    let out = &mut f_out[k * Q..(k + 1) * Q];
-                    if !active[idx] {
-                        continue;
-                    }
-                    // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes.
-                    let mut f = [0.0; Q];
-                    for i in 0..Q {
-                        let s = src[idx * Q + i];
-                        f[i] = if s & WALL == 0 {
-                            f_in[s as usize * Q + i].to_f64()
-                        } else {
-                            let uw = wall_u[(s & !WALL) as usize];
-                            let c = D2Q9::C[i];
-                            let o = D2Q9::OPP[i];
-                            f_in[idx * Q + o].to_f64()
-                                + 6.0 * D2Q9::W[i] * (c[0] as f64 * uw[0] + c[1] as f64 * uw[1])
-                        };
-                    }
-                    // Moments (Su Eq. 13) with the Guo half-force shift.
-                    let mut rho = 0.0;
-                    let mut j = [0.0; 2];
-                    for i in 0..Q {
-                        rho += f[i];
-                        j[0] += f[i] * D2Q9::C[i][0] as f64;
-                        j[1] += f[i] * D2Q9::C[i][1] as f64;
-                    }
-                    let u = [(j[0] + 0.5 * force[0]) / rho, (j[1] + 0.5 * force[1]) / rho];
-                    let usq = u[0] * u[0] + u[1] * u[1];
-                    let mut fe = [0.0; Q];
-                    for i in 0..Q {
-                        fe[i] = feq(i, rho, u, usq);
-                    }
-                    // Fluid part of Eq. 9 plus the Guo source (Leonardi Eq. 16) on the liquid share 1 − B:
-                    // with u shifted by F/2 this puts exactly (1 − B) F of momentum into the node.
-                    let cover = &map.covers[start[idx] as usize..start[idx + 1] as usize];
-                    let eps = map.total[idx];
-                    let b = if cover.is_empty() {
-                        0.0
-                    } else {
-                        psm_weight(eps, tau)
-                    };
-                    let mut post = [0.0; Q];
-                    let mut src_term = [0.0; Q];
-                    for i in 0..Q {
-                        let c = D2Q9::C[i];
-                        let cu = c[0] as f64 * u[0] + c[1] as f64 * u[1];
-                        let s = D2Q9::W[i]
-                            * ((3.0 * (c[0] as f64 - u[0]) + 9.0 * cu * c[0] as f64) * force[0]
-                                + (3.0 * (c[1] as f64 - u[1]) + 9.0 * cu * c[1] as f64) * force[1]);
-                        post[i] = if trt {
-                            0.0 // filled below from the even and odd parts
-                        } else {
-                            f[i] - (1.0 - b) * omega * (f[i] - fe[i]) + (1.0 - b) * (1.0 - 0.5 * omega) * s
-                        };
-                        src_term[i] = s;
-                    }
-                    if trt {
-                        for i in 0..Q {
-                            let o = D2Q9::OPP[i];
-                            let (ne_even, ne_odd) = (
-                                0.5 * ((f[i] - fe[i]) + (f[o] - fe[o])),
-                                0.5 * ((f[i] - fe[i]) - (f[o] - fe[o])),
-                            );
-                            let (s_even, s_odd) = (
-                                0.5 * (src_term[i] + src_term[o]),
-                                0.5 * (src_term[i] - src_term[o]),
-                            );
-                            post[i] = f[i] - (1.0 - b) * (omega * ne_even + omega_odd * ne_odd)
-                                + (1.0 - b)
-                                    * ((1.0 - 0.5 * omega) * s_even + (1.0 - 0.5 * omega_odd) * s_odd);
-                        }
-                    }
-                    // Solid part: Ω of Eq. 11 for each covering grain, weighted by B_s.
-                    let x = [(idx % nx) as f64 + 0.5, (idx / nx) as f64 + 0.5];
-                    for (m, cv) in cover.iter().enumerate() {
-                        let bs = b * cv.fraction / eps;
-                        let g = &grains[cv.body as usize];
-                        let r = min_image(x, g.centre, nx, ny);
-                        let us = g.velocity_at(r);
-                        let ussq = us[0] * us[0] + us[1] * us[1];
-                        let mut p = [0.0; 2];
-                        for i in 0..Q {
-                            let o = D2Q9::OPP[i];
-                            let om = f[o] - f[i] + feq(i, rho, us, ussq) - fe[o];
-                            post[i] += bs * om;
-                            p[0] += bs * om * D2Q9::C[i][0] as f64;
-                            p[1] += bs * om * D2Q9::C[i][1] as f64;
-                        }
-                        let fs = [-p[0], -p[1]];
-                        load_out[start[idx] as usize - c0 + m] = Load {
-                            force: fs,
-                            torque: r[0] * fs[1] - r[1] * fs[0],
-                        };
-                    }
-                    for i in 0..Q {
-                        out[i] = T::from_f64(post[i]);
-                    }
-                    let speed = usq.sqrt();
-                    let ok = rho.is_finite()
-                        && speed.is_finite()
-                        && rho > limits.rho_min
-                        && rho < limits.rho_max
-                        && speed < limits.u_max;
-                    if !ok && first_bad.is_none() {
-                        first_bad = Some((idx, rho, u));
-                    }
-                    rho_out[k] = rho;
-                    u_out[k] = u;
-                }
-                first_bad
-            })
-            .collect::<Vec<_>>()
-            .into_iter()
-            .flatten()
-            .next();
+        let params = self.params;
+        let bad = match &self.local {
+            None => run_chunks(&base, params, tasks, forced),
+            Some((rates, _)) => run_chunks(&base, LocalRates { base: params, rates }, tasks, forced),
+        };
         if let Some((idx, rho, u)) = bad {
-            return Err(CouplingError::Unstable {
+            let tau = match &self.local {
+                Some((_, t)) => t[idx],
+                None => self.settings.collision.tau(),
+            };
+            let bad = BadNode {
                 step: step + 1,
-                node: [idx % nx, idx / nx],
+                node: [idx % nx, idx / nx, 0],
                 rho,
-                u,
-                cause: diagnose(rho, u, tau, &limits),
-            });
+                u: [u[0], u[1], 0.0],
+                tau,
+            };
+            return Err(CouplingError::Lbm(bad.into_error(&limits)));
         }
         std::mem::swap(&mut self.f, &mut self.other);
         self.step += 1;
@@ -424,7 +410,12 @@ impl<T: Real> PsmFluid<T> {
 
     /// BGK relaxation time (TRT: the even one, τ⁺), which sets the viscosity and B of Eq. 10.
     pub fn tau(&self) -> f64 {
-        self.settings.tau
+        self.settings.collision.tau()
+    }
+
+    /// The settings the lattice was built with (the collision after `with_trt`).
+    pub fn settings(&self) -> &PsmSettings {
+        &self.settings
     }
 
     /// Whether node `idx` is updated (not in the inactive zone).
@@ -448,16 +439,155 @@ pub(crate) fn min_image(x: [f64; 2], c: [f64; 2], nx: usize, ny: usize) -> [f64;
     d
 }
 
-fn diagnose(rho: f64, u: [f64; 2], tau: f64, limits: &Limits) -> String {
-    let speed = (u[0] * u[0] + u[1] * u[1]).sqrt();
-    if !rho.is_finite() || !speed.is_finite() {
-        format!("non-finite state; tau = {tau} is too close to 0.5 or the grains move too fast for dt")
-    } else if speed >= limits.u_max {
-        format!(
-            "velocity {speed:.3} (lattice) above {}: Mach too high; reduce the LBM time step",
-            limits.u_max
-        )
-    } else {
-        "density out of range: pressure waves too strong; reduce the LBM time step or the grain speed".into()
+/// What every chunk of a step reads.
+struct Base<'a, T> {
+    nx: usize,
+    ny: usize,
+    f_in: &'a [T],
+    src: &'a [u32],
+    wall_u: &'a [[f64; 2]],
+    active: &'a [bool],
+    map: &'a SolidMap,
+    start: &'a [u32],
+    grains: &'a [GrainMotion],
+    tau: f64,
+    local_tau: Option<&'a [f64]>,
+    limits: Limits,
+}
+
+/// The nodes [node0, node0 + rho.len()) of one task and its share of the outputs.
+struct Chunk<'a, T> {
+    node0: usize,
+    f_out: &'a mut [T],
+    rho: &'a mut [f64],
+    u: &'a mut [[f64; 2]],
+    loads: &'a mut [Load],
+}
+
+/// Every chunk on the rayon pool with the liquid collision `C`; the first node outside the
+/// limits (node order), if any: (node, ρ, u).
+fn run_chunks<T: Real, C: Collider<D2Q9, f64>>(
+    base: &Base<T>,
+    coll: C,
+    tasks: Vec<Chunk<T>>,
+    forced: bool,
+) -> Option<(usize, f64, [f64; 2])> {
+    tasks
+        .into_par_iter()
+        .map(|c| {
+            if forced {
+                chunk::<T, C, true>(base, &coll, c)
+            } else {
+                chunk::<T, C, false>(base, &coll, c)
+            }
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .flatten()
+        .next()
+}
+
+/// One chunk of nodes: pull-stream (Su Eq. 12) with bounce-back from walls and inactive nodes,
+/// then the PSM collision of Su Eq. 9,
+///
+///   f_i⁺ = f_i + (1 − B)(C(f)_i − f_i) + Σ_s B_s Ω_i^s,
+///
+/// where C is the liquid collision of `lbdem-lbm` (BGK, Su Eq. 9 with B = 0, or TRT, with the
+/// Guo source of Leonardi Eq. 16 and u = (Σ f c + F/2)/ρ, Su Eq. 13 / Leonardi Eq. 17: with B the
+/// node receives exactly (1 − B) F of momentum), B from Eq. 10, B_s = B ε_s / ε so that
+/// Σ_s B_s = B, and Ω^s the solid term of Eq. 11. The load on grain s is the reaction to the
+/// momentum Ω^s puts into the liquid (Eq. 14).
+fn chunk<T: Real, C: Collider<D2Q9, f64>, const F: bool>(
+    b: &Base<T>,
+    coll: &C,
+    out: Chunk<T>,
+) -> Option<(usize, f64, [f64; 2])> {
+    let Chunk {
+        node0,
+        f_out,
+        rho: rho_out,
+        u: u_out,
+        loads: load_out,
+    } = out;
+    let c0 = b.start[node0] as usize;
+    let mut first_bad = None;
+    for k in 0..rho_out.len() {
+        let idx = node0 + k;
+        if !b.active[idx] {
+            continue;
+        }
+        // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes (Leonardi Eq. 19).
+        let mut f = [0.0; Q];
+        for i in 0..Q {
+            let s = b.src[idx * Q + i];
+            f[i] = if s & WALL == 0 {
+                b.f_in[s as usize * Q + i].to_f64()
+            } else {
+                let uw = b.wall_u[(s & !WALL) as usize];
+                let c = D2Q9::C[i];
+                let o = D2Q9::OPP[i];
+                b.f_in[idx * Q + o].to_f64() + 6.0 * D2Q9::W[i] * (c[0] as f64 * uw[0] + c[1] as f64 * uw[1])
+            };
+        }
+        // The liquid collision C(f) and the moments it used.
+        let mut post = [[0.0; 1]; QMAX];
+        for i in 0..Q {
+            post[i][0] = f[i];
+        }
+        let m = C::collide::<1, F>(coll, &mut post, idx);
+        let rho = m.rho[0];
+        let u = [m.u[0][0], m.u[1][0]];
+        let cover: &[CellCover] = &b.map.covers[b.start[idx] as usize..b.start[idx + 1] as usize];
+        let mut new = [0.0; Q];
+        if cover.is_empty() {
+            // B = 0: Eq. 9 is the liquid collision alone
+            for i in 0..Q {
+                new[i] = post[i][0];
+            }
+        } else {
+            let eps = b.map.total[idx];
+            let tau = b.local_tau.map_or(b.tau, |t| t[idx]);
+            let weight = psm_weight(eps, tau);
+            for i in 0..Q {
+                new[i] = f[i] + (1.0 - weight) * (post[i][0] - f[i]);
+            }
+            let usq = u[0] * u[0] + u[1] * u[1];
+            let mut fe = [0.0; Q];
+            for i in 0..Q {
+                fe[i] = feq(i, rho, u, usq);
+            }
+            // Solid part: Ω of Eq. 11 for each covering grain, weighted by B_s.
+            let x = [(idx % b.nx) as f64 + 0.5, (idx / b.nx) as f64 + 0.5];
+            for (mm, cv) in cover.iter().enumerate() {
+                let bs = weight * cv.fraction / eps;
+                let g = &b.grains[cv.body as usize];
+                let r = min_image(x, g.centre, b.nx, b.ny);
+                let us = g.velocity_at(r);
+                let ussq = us[0] * us[0] + us[1] * us[1];
+                let mut p = [0.0; 2];
+                for i in 0..Q {
+                    let o = D2Q9::OPP[i];
+                    let om = f[o] - f[i] + feq(i, rho, us, ussq) - fe[o];
+                    new[i] += bs * om;
+                    p[0] += bs * om * D2Q9::C[i][0] as f64;
+                    p[1] += bs * om * D2Q9::C[i][1] as f64;
+                }
+                let fs = [-p[0], -p[1]];
+                load_out[b.start[idx] as usize - c0 + mm] = Load {
+                    force: fs,
+                    torque: r[0] * fs[1] - r[1] * fs[0],
+                };
+            }
+        }
+        let out = &mut f_out[k * Q..(k + 1) * Q];
+        for i in 0..Q {
+            out[i] = T::from_f64(new[i]);
+        }
+        if !b.limits.accepts(rho, [u[0], u[1], 0.0]) && first_bad.is_none() {
+            first_bad = Some((idx, rho, u));
+        }
+        rho_out[k] = rho;
+        u_out[k] = u;
     }
+    first_bad
 }

@@ -175,7 +175,7 @@ fn run_with<T: Real>(cfg: &CoupledScene, ctx: &SimContext) -> Result<StageOutput
             let mut fluid = PsmFluid::<T>::new(
                 &domain,
                 PsmSettings {
-                    tau,
+                    collision: lbdem_lbm::Collision::Bgk { tau },
                     force: [0.0; 2],
                     limits,
                 },
