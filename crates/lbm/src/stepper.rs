@@ -85,7 +85,7 @@ impl<L: Lattice, T: Real> Fluid<L, T> {
 }
 
 /// Macroscopic fields of the last step (written by the kernel when asked).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Macro {
     pub rho: Vec<f64>,
     /// Interleaved xyz.

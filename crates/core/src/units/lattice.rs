@@ -77,7 +77,7 @@ impl LatticeInput {
 }
 
 /// The derived lattice units.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LatticeUnits {
     pub dx: f64,
     pub dt: f64,
@@ -104,6 +104,11 @@ pub enum UnitsError {
          would be zero or negative); raise tau, or raise dt / lower dx so that tau = 0.5 + 3 nu dt/dx^2 > 0.5"
     )]
     Tau { tau: f64 },
+    #[error(
+        "LBM-DEM time-step ratio dt_lbm / dt_dem = {ratio} must be a whole number >= 1 \
+         (Su et al. 2020 Table 3); set dt_dem = dt_lbm / N for a whole N"
+    )]
+    Ratio { ratio: f64 },
     #[error(
         "Mach number Ma = {mach:.3} (u_max = {u_max} m/s, dt = {dt:e} s, dx = {dx:e} m, Su et al. 2020 \
          Eq. 16) is above the limit {limit}; lower dt (tau closer to 0.5) or coarsen dx so that \
