@@ -174,7 +174,8 @@ impl<T: Real> Hydro<T> {
         match self {
             Hydro::Psm { fluid, .. } => {
                 if fluid.is_active(idx) {
-                    (fluid.rho[idx], fluid.u[idx])
+                    let u = fluid.u[idx];
+                    (fluid.rho[idx], [u[0], u[1]])
                 } else {
                     (f64::NAN, [f64::NAN; 2])
                 }

@@ -1,6 +1,10 @@
-//! The partially-saturated-cells (PSM) lattice: D2Q9 populations coupled to moving grains by
+//! The partially-saturated-cells (PSM) lattice: populations coupled to moving grains by
 //! the Noble-Torczynski collision (Su et al. 2020 Eqs. 9-11) and the hydrodynamic force and
-//! moment on each grain (Eq. 14).
+//! moment on each grain (Eq. 14). Written over the lattice (`PsmFluid<T, L>`, D2Q9 by default,
+//! D3Q19 too): the 2D API (`step` with `GrainMotion` and `Load`, `init_equilibrium`,
+//! `mass_momentum`) is D2Q9's; any lattice steps with `step_motions` (`lbdem_lbm::Motion`,
+//! `ForceTorque`). The solid-fraction map of `solid_fraction` (circle ∩ square cells) stays 2D:
+//! a 3D run brings its own `SolidMap` (cell index = node index x + nx (y + ny z)).
 //!
 //! Storage is array-of-structures (`f[node * 9 + i]`) so that rows of nodes are contiguous and
 //! can be handed to rayon tasks as plain slices; coupled grids are small (Su et al.: about
@@ -20,11 +24,13 @@ use crate::weighting::psm_weight;
 use lbdem_lbm::collision::{CollideParams, Collider, LocalRates, NodeRates, local_rates};
 use lbdem_lbm::lattice::QMAX;
 use lbdem_lbm::plan::{Upstream, neighbour};
-use lbdem_lbm::{BadNode, Collision, D2Q9, Domain, Face, Lattice, LbmError, Limits, Real};
+use lbdem_lbm::{
+    BadNode, Collision, D2Q9, Domain, Face, ForceTorque, Lattice, LbmError, Limits, Motion, Real,
+};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::marker::PhantomData;
 
-const Q: usize = 9;
 /// Rows per rayon task: fixed, so the split is the same for every pool size.
 const ROWS_PER_TASK: usize = 4;
 /// Marker bit of a pull source that is a bounce-back link (low bits: wall index).
@@ -69,17 +75,19 @@ pub struct PsmSettings {
     pub limits: Limits,
 }
 
-/// Populations and the streaming table of a 2D PSM lattice.
-pub struct PsmFluid<T: Real> {
+/// Populations and the streaming table of a PSM lattice (D2Q9 unless `L` says otherwise).
+pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
     pub nx: usize,
     pub ny: usize,
-    /// Post-collision populations of the current time, `f[node * 9 + i]`.
+    /// 1 in 2D.
+    pub nz: usize,
+    /// Post-collision populations of the current time, `f[node * Q + i]`.
     pub f: Vec<T>,
     other: Vec<T>,
     /// Pull source of population i at node x: index of the upstream node, or `WALL | w`.
     src: Vec<u32>,
     /// Wall velocities (index 0: stationary inactive nodes; 1 + face for box walls).
-    wall_u: Vec<[f64; 2]>,
+    wall_u: Vec<[f64; 3]>,
     /// Inactive nodes (outside the sample: the "solid zone" of Su Sect. 2.4) are never updated.
     active: Vec<bool>,
     settings: PsmSettings,
@@ -87,12 +95,16 @@ pub struct PsmFluid<T: Real> {
     params: CollideParams<f64>,
     /// Per-node rates and the τ they came from (`set_local_tau`).
     local: Option<(Vec<NodeRates<f64>>, Vec<f64>)>,
-    /// Density and velocity of every node after the last step.
+    /// Density and velocity of every node after the last step (z = 0 in 2D).
     pub rho: Vec<f64>,
-    pub u: Vec<[f64; 2]>,
+    pub u: Vec<[f64; 3]>,
     /// Per cover of the last solid map: the load its grain received there.
-    cover_load: Vec<Load>,
+    cover_load: Vec<ForceTorque>,
+    /// The 2D `step`'s grains and loads in the lattice-independent form (scratch).
+    motions: Vec<Motion>,
+    loads3: Vec<ForceTorque>,
     pub step: u64,
+    _l: PhantomData<L>,
 }
 
 /// What a PSM lattice needs besides its domain and settings to continue a run bit for bit
@@ -103,27 +115,43 @@ pub struct PsmFluid<T: Real> {
 pub struct PsmState<T: Real> {
     pub f: Vec<T>,
     pub rho: Vec<f64>,
-    pub u: Vec<[f64; 2]>,
+    pub u: Vec<[f64; 3]>,
     pub local_tau: Option<Vec<f64>>,
     pub step: u64,
 }
 
-/// Equilibrium of D2Q9 (Su Eq. 7).
+/// Equilibrium (Su Eq. 7, Leonardi Eq. 13).
 #[inline(always)]
-fn feq(i: usize, rho: f64, u: [f64; 2], usq: f64) -> f64 {
-    let c = D2Q9::C[i];
-    let cu = c[0] as f64 * u[0] + c[1] as f64 * u[1];
-    D2Q9::W[i] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * usq)
+fn feq<L: Lattice>(i: usize, rho: f64, u: [f64; 3], usq: f64) -> f64 {
+    let c = L::C[i];
+    let mut cu = c[0] as f64 * u[0] + c[1] as f64 * u[1];
+    if L::D == 3 {
+        cu += c[2] as f64 * u[2];
+    }
+    L::W[i] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * usq)
 }
 
-impl<T: Real> PsmFluid<T> {
-    /// A fluid at rest with density 1 on the 2D `domain` (faces periodic or walls; nodes of
-    /// kind other than fluid are inactive and act as stationary bounce-back walls).
+/// |u|² over the lattice's dimensions (the 2D sum is the one of the 2D code).
+#[inline(always)]
+fn norm2<L: Lattice>(u: [f64; 3]) -> f64 {
+    let mut s = u[0] * u[0] + u[1] * u[1];
+    if L::D == 3 {
+        s += u[2] * u[2];
+    }
+    s
+}
+
+impl<T: Real, L: Lattice> PsmFluid<T, L> {
+    /// A fluid at rest with density 1 on `domain` (nz = 1 for D2Q9, nz > 1 for D3Q19; faces
+    /// periodic or walls; nodes of kind other than fluid are inactive and act as stationary
+    /// bounce-back walls).
     pub fn new(domain: &Domain, settings: PsmSettings) -> Result<Self, CouplingError> {
         let [nx, ny, nz] = domain.n;
-        if nz != 1 {
+        if (L::D == 2) != (nz == 1) {
             return Err(CouplingError::Unsupported(format!(
-                "the PSM coupling is 2D (D2Q9); the domain has nz = {nz}, set it to 1"
+                "PSM lattice {} on a box of {nx} x {ny} x {nz} nodes: use nz = 1 with D2Q9 and nz > 1 \
+                 with D3Q19",
+                L::NAME
             )));
         }
         let tau = settings.collision.tau();
@@ -132,11 +160,15 @@ impl<T: Real> PsmFluid<T> {
         }
         let params =
             CollideParams::<f64>::new(&settings.collision, [settings.force[0], settings.force[1], 0.0])?;
-        let mut wall_u = vec![[0.0; 2]];
+        let mut wall_u = vec![[0.0; 3]];
         for face in &domain.faces {
             match face {
-                Face::Periodic => wall_u.push([0.0; 2]),
-                Face::Wall { velocity } => wall_u.push([velocity[0], velocity[1]]),
+                Face::Periodic => wall_u.push([0.0; 3]),
+                Face::Wall { velocity } => wall_u.push(if L::D == 3 {
+                    *velocity
+                } else {
+                    [velocity[0], velocity[1], 0.0]
+                }),
                 other => {
                     return Err(CouplingError::Unsupported(format!(
                         "face {other:?}: the PSM lattice takes periodic faces or walls only"
@@ -144,35 +176,35 @@ impl<T: Real> PsmFluid<T> {
                 }
             }
         }
-        let n = nx * ny;
+        let n = nx * ny * nz;
+        let q = L::Q;
         let active: Vec<bool> = domain
             .kind
             .iter()
             .map(|&k| k == lbdem_lbm::domain::FLUID)
             .collect();
-        let mut src = vec![0u32; n * Q];
-        for y in 0..ny {
-            for x in 0..nx {
-                let idx = x + nx * y;
-                for i in 0..Q {
-                    let c = D2Q9::C[i];
-                    src[idx * Q + i] = match neighbour(domain, [x, y, 0], [-c[0], -c[1], 0]) {
-                        Upstream::Node(j) if active[j] => j as u32,
-                        Upstream::Node(_) => WALL,
-                        Upstream::Face(f) => WALL | (1 + f as u32),
-                    };
-                }
+        let mut src = vec![0u32; n * q];
+        for idx in 0..n {
+            let p = domain.coords(idx);
+            for i in 0..q {
+                let c = L::C[i];
+                src[idx * q + i] = match neighbour(domain, p, [-c[0], -c[1], -c[2]]) {
+                    Upstream::Node(j) if active[j] => j as u32,
+                    Upstream::Node(_) => WALL,
+                    Upstream::Face(f) => WALL | (1 + f as u32),
+                };
             }
         }
-        let mut f = vec![T::default(); n * Q];
-        for node in f.chunks_exact_mut(Q) {
-            for i in 0..Q {
-                node[i] = T::from_f64(D2Q9::W[i]);
+        let mut f = vec![T::default(); n * q];
+        for node in f.chunks_exact_mut(q) {
+            for i in 0..q {
+                node[i] = T::from_f64(L::W[i]);
             }
         }
         Ok(Self {
             nx,
             ny,
+            nz,
             other: f.clone(),
             f,
             src,
@@ -182,9 +214,12 @@ impl<T: Real> PsmFluid<T> {
             params,
             local: None,
             rho: vec![1.0; n],
-            u: vec![[0.0; 2]; n],
+            u: vec![[0.0; 3]; n],
             cover_load: Vec::new(),
+            motions: Vec::new(),
+            loads3: Vec::new(),
             step: 0,
+            _l: PhantomData,
         })
     }
 
@@ -213,7 +248,7 @@ impl<T: Real> PsmFluid<T> {
     /// rheology (Bingham, Leonardi et al. 2014 Eq. 8). Equal values everywhere give the uniform
     /// run bit for bit.
     pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), CouplingError> {
-        let nodes = self.nx * self.ny;
+        let nodes = self.nodes();
         if tau.len() != nodes {
             return Err(LbmError::LocalTauLength {
                 got: tau.len(),
@@ -247,8 +282,8 @@ impl<T: Real> PsmFluid<T> {
 
     /// Continue from `state` on a lattice built with the same domain and settings.
     pub fn restore(&mut self, state: PsmState<T>) -> Result<(), CouplingError> {
-        let n = self.nx * self.ny;
-        if state.f.len() != n * Q || state.rho.len() != n || state.u.len() != n {
+        let n = self.nodes();
+        if state.f.len() != n * L::Q || state.rho.len() != n || state.u.len() != n {
             return Err(CouplingError::Unsupported(format!(
                 "PSM state of {} populations and {} nodes for a lattice of {} x {} nodes: restore into \
                  a lattice built with the checkpoint's domain",
@@ -269,53 +304,54 @@ impl<T: Real> PsmFluid<T> {
         Ok(())
     }
 
-    /// Set every node to the equilibrium of density `rho` and velocity `u(x, y)`.
-    pub fn init_equilibrium(&mut self, init: impl Fn(usize, usize) -> (f64, [f64; 2])) {
-        for idx in 0..self.nx * self.ny {
-            let (rho, u) = init(idx % self.nx, idx / self.nx);
-            let usq = u[0] * u[0] + u[1] * u[1];
-            for i in 0..Q {
-                self.f[idx * Q + i] = T::from_f64(feq(i, rho, u, usq));
-            }
-            self.rho[idx] = rho;
-            self.u[idx] = u;
-        }
+    /// Nodes of the lattice.
+    pub fn nodes(&self) -> usize {
+        self.nx * self.ny * self.nz
     }
 
-    /// Total mass and momentum of the populations (lattice units).
-    pub fn mass_momentum(&self) -> (f64, [f64; 2]) {
-        let (mut m, mut j) = (0.0, [0.0; 2]);
-        for (node, a) in self.f.chunks_exact(Q).zip(&self.active) {
+    /// Total mass and momentum of the populations of the active nodes (lattice units).
+    pub fn mass_momentum3(&self) -> (f64, [f64; 3]) {
+        let q = L::Q;
+        let (mut m, mut j) = (0.0, [0.0; 3]);
+        for (node, a) in self.f.chunks_exact(q).zip(&self.active) {
             if !a {
                 continue;
             }
-            for i in 0..Q {
+            for i in 0..q {
                 let v = node[i].to_f64();
                 m += v;
-                j[0] += v * D2Q9::C[i][0] as f64;
-                j[1] += v * D2Q9::C[i][1] as f64;
+                j[0] += v * L::C[i][0] as f64;
+                j[1] += v * L::C[i][1] as f64;
+                if L::D == 3 {
+                    j[2] += v * L::C[i][2] as f64;
+                }
             }
         }
         (m, j)
     }
 
-    /// One LBM step: pull-stream, then collide with the PSM term of every grain covering each
-    /// node (Su Eq. 9, per-grain weights B_s = B ε_s / ε so that Σ_s B_s = B of Eq. 10), and
-    /// return the load on each of `grains.len()` grains (Eq. 14, summed over the grain's
-    /// circles because the map holds one cover per grain and cell).
+    /// One LBM step on any lattice: pull-stream, then collide with the PSM term of every grain
+    /// covering each node (Su Eq. 9, per-grain weights B_s = B ε_s / ε so that Σ_s B_s = B of
+    /// Eq. 10), and return the force and moment on each of `grains.len()` grains (Eq. 14, summed
+    /// over the grain's cells). Grain centres are in lattice coordinates with node i at i + ½
+    /// (z = 0 in 2D); the map's cell index is the node index.
     ///
     /// The force on a grain is the reaction to the momentum its solid term puts into the
     /// fluid: F_s = −Σ_x B_s Σ_i Ω_i^s c_i (Su writes Eq. 14 as the momentum transfer; the
     /// sign here makes fluid plus grains conserve momentum, which a test checks).
-    pub fn step(
+    pub fn step_motions(
         &mut self,
         map: &SolidMap,
-        grains: &[GrainMotion],
-        loads: &mut Vec<Load>,
+        grains: &[Motion],
+        loads: &mut Vec<ForceTorque>,
     ) -> Result<(), CouplingError> {
-        let (nx, ny) = (self.nx, self.ny);
-        assert_eq!((map.nx, map.ny), (nx, ny), "solid map and lattice differ in size");
-        let n = nx * ny;
+        let (nx, ny, nz) = (self.nx, self.ny, self.nz);
+        let n = self.nodes();
+        assert!(
+            (map.nx, map.ny) == (nx, ny) && map.total.len() == n,
+            "solid map and lattice differ in size"
+        );
+        let q = L::Q;
         // Covers of cell c are covers[start[c]..start[c + 1]] (the map is sorted by cell).
         let mut start = vec![0u32; n + 1];
         for cv in &map.covers {
@@ -325,7 +361,7 @@ impl<T: Real> PsmFluid<T> {
             start[c + 1] += start[c];
         }
         self.cover_load.clear();
-        self.cover_load.resize(map.covers.len(), Load::default());
+        self.cover_load.resize(map.covers.len(), ForceTorque::default());
 
         let forced = self.settings.force.iter().any(|&x| x != 0.0);
         let limits = self.settings.limits;
@@ -333,6 +369,7 @@ impl<T: Real> PsmFluid<T> {
         let base = Base {
             nx,
             ny,
+            nz,
             f_in: &self.f,
             src: &self.src,
             wall_u: &self.wall_u,
@@ -351,12 +388,12 @@ impl<T: Real> PsmFluid<T> {
         {
             let mut f_out: &mut [T] = &mut self.other;
             let mut rho: &mut [f64] = &mut self.rho;
-            let mut u: &mut [[f64; 2]] = &mut self.u;
-            let mut loads_rest: &mut [Load] = &mut self.cover_load;
+            let mut u: &mut [[f64; 3]] = &mut self.u;
+            let mut loads_rest: &mut [ForceTorque] = &mut self.cover_load;
             let mut node0 = 0;
             while node0 < n {
                 let len = rows_chunk.min(n - node0);
-                let (fa, fb) = std::mem::take(&mut f_out).split_at_mut(len * Q);
+                let (fa, fb) = std::mem::take(&mut f_out).split_at_mut(len * q);
                 let (ra, rb) = std::mem::take(&mut rho).split_at_mut(len);
                 let (ua, ub) = std::mem::take(&mut u).split_at_mut(len);
                 let nc = (start[node0 + len] - start[node0]) as usize;
@@ -377,8 +414,10 @@ impl<T: Real> PsmFluid<T> {
         }
         let params = self.params;
         let bad = match &self.local {
-            None => run_chunks(&base, params, tasks, forced),
-            Some((rates, _)) => run_chunks(&base, LocalRates { base: params, rates }, tasks, forced),
+            None => run_chunks::<T, L, _>(&base, params, tasks, forced),
+            Some((rates, _)) => {
+                run_chunks::<T, L, _>(&base, LocalRates { base: params, rates }, tasks, forced)
+            }
         };
         if let Some((idx, rho, u)) = bad {
             let tau = match &self.local {
@@ -387,9 +426,9 @@ impl<T: Real> PsmFluid<T> {
             };
             let bad = BadNode {
                 step: step + 1,
-                node: [idx % nx, idx / nx, 0],
+                node: [idx % nx, (idx / nx) % ny, idx / (nx * ny)],
                 rho,
-                u: [u[0], u[1], 0.0],
+                u,
                 tau,
             };
             return Err(CouplingError::Lbm(bad.into_error(&limits)));
@@ -398,12 +437,13 @@ impl<T: Real> PsmFluid<T> {
         self.step += 1;
 
         loads.clear();
-        loads.resize(grains.len(), Load::default());
+        loads.resize(grains.len(), ForceTorque::default());
         for (cv, l) in map.covers.iter().zip(&self.cover_load) {
             let t = &mut loads[cv.body as usize];
-            t.force[0] += l.force[0];
-            t.force[1] += l.force[1];
-            t.torque += l.torque;
+            for a in 0..3 {
+                t.force[a] += l.force[a];
+                t.torque[a] += l.torque[a];
+            }
         }
         Ok(())
     }
@@ -424,6 +464,58 @@ impl<T: Real> PsmFluid<T> {
     }
 }
 
+/// The 2D API (grains as `GrainMotion`, loads as `Load`).
+impl<T: Real> PsmFluid<T, D2Q9> {
+    /// Set every node to the equilibrium of density `rho` and velocity `u(x, y)`.
+    pub fn init_equilibrium(&mut self, init: impl Fn(usize, usize) -> (f64, [f64; 2])) {
+        let q = D2Q9::Q;
+        for idx in 0..self.nx * self.ny {
+            let (rho, u) = init(idx % self.nx, idx / self.nx);
+            let u = [u[0], u[1], 0.0];
+            let usq = norm2::<D2Q9>(u);
+            for i in 0..q {
+                self.f[idx * q + i] = T::from_f64(feq::<D2Q9>(i, rho, u, usq));
+            }
+            self.rho[idx] = rho;
+            self.u[idx] = u;
+        }
+    }
+
+    /// Total mass and momentum of the populations (lattice units).
+    pub fn mass_momentum(&self) -> (f64, [f64; 2]) {
+        let (m, j) = self.mass_momentum3();
+        (m, [j[0], j[1]])
+    }
+
+    /// One LBM step with the grains' 2D motions; the load on each of `grains.len()` grains
+    /// (Eq. 14, summed over the grain's circles because the map holds one cover per grain and
+    /// cell). See [`PsmFluid::step_motions`].
+    pub fn step(
+        &mut self,
+        map: &SolidMap,
+        grains: &[GrainMotion],
+        loads: &mut Vec<Load>,
+    ) -> Result<(), CouplingError> {
+        let mut motions = std::mem::take(&mut self.motions);
+        let mut loads3 = std::mem::take(&mut self.loads3);
+        motions.clear();
+        motions.extend(grains.iter().map(|g| Motion {
+            centre: [g.centre[0], g.centre[1], 0.0],
+            velocity: [g.velocity[0], g.velocity[1], 0.0],
+            omega: [0.0, 0.0, g.omega],
+        }));
+        let r = self.step_motions(map, &motions, &mut loads3);
+        loads.clear();
+        loads.extend(loads3.iter().map(|l| Load {
+            force: [l.force[0], l.force[1]],
+            torque: l.torque[2],
+        }));
+        self.motions = motions;
+        self.loads3 = loads3;
+        r
+    }
+}
+
 /// Offset x − c with the minimum-image convention on a periodic nx × ny lattice (harmless on
 /// walled boxes: grains never sit half a box away from the nodes they cover).
 #[inline]
@@ -439,17 +531,48 @@ pub(crate) fn min_image(x: [f64; 2], c: [f64; 2], nx: usize, ny: usize) -> [f64;
     d
 }
 
+/// Offset x − c with the minimum-image convention on a periodic box (the 2D arithmetic of
+/// `min_image` for x and y; z only in 3D).
+#[inline]
+fn min_image3<L: Lattice>(x: [f64; 3], c: [f64; 3], n: [usize; 3]) -> [f64; 3] {
+    let d = min_image([x[0], x[1]], [c[0], c[1]], n[0], n[1]);
+    let mut z = 0.0;
+    if L::D == 3 {
+        let l = n[2] as f64;
+        z = x[2] - c[2];
+        if z > 0.5 * l {
+            z -= l;
+        } else if z < -0.5 * l {
+            z += l;
+        }
+    }
+    [d[0], d[1], z]
+}
+
+/// Velocity of a grain's material at offset `r`: v + ω × r (Leonardi Eq. 20); in 2D the
+/// expression of `GrainMotion::velocity_at`.
+#[inline]
+fn velocity_at<L: Lattice>(g: &Motion, r: [f64; 3]) -> [f64; 3] {
+    if L::D == 3 {
+        g.velocity_at(r)
+    } else {
+        let w = g.omega[2];
+        [g.velocity[0] - w * r[1], g.velocity[1] + w * r[0], 0.0]
+    }
+}
+
 /// What every chunk of a step reads.
 struct Base<'a, T> {
     nx: usize,
     ny: usize,
+    nz: usize,
     f_in: &'a [T],
     src: &'a [u32],
-    wall_u: &'a [[f64; 2]],
+    wall_u: &'a [[f64; 3]],
     active: &'a [bool],
     map: &'a SolidMap,
     start: &'a [u32],
-    grains: &'a [GrainMotion],
+    grains: &'a [Motion],
     tau: f64,
     local_tau: Option<&'a [f64]>,
     limits: Limits,
@@ -460,25 +583,25 @@ struct Chunk<'a, T> {
     node0: usize,
     f_out: &'a mut [T],
     rho: &'a mut [f64],
-    u: &'a mut [[f64; 2]],
-    loads: &'a mut [Load],
+    u: &'a mut [[f64; 3]],
+    loads: &'a mut [ForceTorque],
 }
 
 /// Every chunk on the rayon pool with the liquid collision `C`; the first node outside the
 /// limits (node order), if any: (node, ρ, u).
-fn run_chunks<T: Real, C: Collider<D2Q9, f64>>(
+fn run_chunks<T: Real, L: Lattice, C: Collider<L, f64>>(
     base: &Base<T>,
     coll: C,
     tasks: Vec<Chunk<T>>,
     forced: bool,
-) -> Option<(usize, f64, [f64; 2])> {
+) -> Option<(usize, f64, [f64; 3])> {
     tasks
         .into_par_iter()
         .map(|c| {
             if forced {
-                chunk::<T, C, true>(base, &coll, c)
+                chunk::<T, L, C, true>(base, &coll, c)
             } else {
-                chunk::<T, C, false>(base, &coll, c)
+                chunk::<T, L, C, false>(base, &coll, c)
             }
         })
         .collect::<Vec<_>>()
@@ -497,11 +620,12 @@ fn run_chunks<T: Real, C: Collider<D2Q9, f64>>(
 /// node receives exactly (1 − B) F of momentum), B from Eq. 10, B_s = B ε_s / ε so that
 /// Σ_s B_s = B, and Ω^s the solid term of Eq. 11. The load on grain s is the reaction to the
 /// momentum Ω^s puts into the liquid (Eq. 14).
-fn chunk<T: Real, C: Collider<D2Q9, f64>, const F: bool>(
+fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
     b: &Base<T>,
     coll: &C,
     out: Chunk<T>,
-) -> Option<(usize, f64, [f64; 2])> {
+) -> Option<(usize, f64, [f64; 3])> {
+    let q = L::Q;
     let Chunk {
         node0,
         f_out,
@@ -517,73 +641,92 @@ fn chunk<T: Real, C: Collider<D2Q9, f64>, const F: bool>(
             continue;
         }
         // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes (Leonardi Eq. 19).
-        let mut f = [0.0; Q];
-        for i in 0..Q {
-            let s = b.src[idx * Q + i];
+        let mut f = [0.0; QMAX];
+        for i in 0..q {
+            let s = b.src[idx * q + i];
             f[i] = if s & WALL == 0 {
-                b.f_in[s as usize * Q + i].to_f64()
+                b.f_in[s as usize * q + i].to_f64()
             } else {
                 let uw = b.wall_u[(s & !WALL) as usize];
-                let c = D2Q9::C[i];
-                let o = D2Q9::OPP[i];
-                b.f_in[idx * Q + o].to_f64() + 6.0 * D2Q9::W[i] * (c[0] as f64 * uw[0] + c[1] as f64 * uw[1])
+                let c = L::C[i];
+                let o = L::OPP[i];
+                let mut cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1];
+                if L::D == 3 {
+                    cu += c[2] as f64 * uw[2];
+                }
+                b.f_in[idx * q + o].to_f64() + 6.0 * L::W[i] * cu
             };
         }
         // The liquid collision C(f) and the moments it used.
         let mut post = [[0.0; 1]; QMAX];
-        for i in 0..Q {
+        for i in 0..q {
             post[i][0] = f[i];
         }
         let m = C::collide::<1, F>(coll, &mut post, idx);
         let rho = m.rho[0];
-        let u = [m.u[0][0], m.u[1][0]];
+        let u = [m.u[0][0], m.u[1][0], m.u[2][0]];
         let cover: &[CellCover] = &b.map.covers[b.start[idx] as usize..b.start[idx + 1] as usize];
-        let mut new = [0.0; Q];
+        let mut new = [0.0; QMAX];
         if cover.is_empty() {
             // B = 0: Eq. 9 is the liquid collision alone
-            for i in 0..Q {
+            for i in 0..q {
                 new[i] = post[i][0];
             }
         } else {
             let eps = b.map.total[idx];
             let tau = b.local_tau.map_or(b.tau, |t| t[idx]);
             let weight = psm_weight(eps, tau);
-            for i in 0..Q {
+            for i in 0..q {
                 new[i] = f[i] + (1.0 - weight) * (post[i][0] - f[i]);
             }
-            let usq = u[0] * u[0] + u[1] * u[1];
-            let mut fe = [0.0; Q];
-            for i in 0..Q {
-                fe[i] = feq(i, rho, u, usq);
+            let usq = norm2::<L>(u);
+            let mut fe = [0.0; QMAX];
+            for i in 0..q {
+                fe[i] = feq::<L>(i, rho, u, usq);
             }
             // Solid part: Ω of Eq. 11 for each covering grain, weighted by B_s.
-            let x = [(idx % b.nx) as f64 + 0.5, (idx / b.nx) as f64 + 0.5];
+            let x = [
+                (idx % b.nx) as f64 + 0.5,
+                ((idx / b.nx) % b.ny) as f64 + 0.5,
+                if L::D == 3 {
+                    (idx / (b.nx * b.ny)) as f64 + 0.5
+                } else {
+                    0.0
+                },
+            ];
             for (mm, cv) in cover.iter().enumerate() {
                 let bs = weight * cv.fraction / eps;
                 let g = &b.grains[cv.body as usize];
-                let r = min_image(x, g.centre, b.nx, b.ny);
-                let us = g.velocity_at(r);
-                let ussq = us[0] * us[0] + us[1] * us[1];
-                let mut p = [0.0; 2];
-                for i in 0..Q {
-                    let o = D2Q9::OPP[i];
-                    let om = f[o] - f[i] + feq(i, rho, us, ussq) - fe[o];
+                let r = min_image3::<L>(x, g.centre, [b.nx, b.ny, b.nz]);
+                let us = velocity_at::<L>(g, r);
+                let ussq = norm2::<L>(us);
+                let mut p = [0.0; 3];
+                for i in 0..q {
+                    let o = L::OPP[i];
+                    let om = f[o] - f[i] + feq::<L>(i, rho, us, ussq) - fe[o];
                     new[i] += bs * om;
-                    p[0] += bs * om * D2Q9::C[i][0] as f64;
-                    p[1] += bs * om * D2Q9::C[i][1] as f64;
+                    p[0] += bs * om * L::C[i][0] as f64;
+                    p[1] += bs * om * L::C[i][1] as f64;
+                    if L::D == 3 {
+                        p[2] += bs * om * L::C[i][2] as f64;
+                    }
                 }
-                let fs = [-p[0], -p[1]];
-                load_out[b.start[idx] as usize - c0 + mm] = Load {
+                let fs = [-p[0], -p[1], -p[2]];
+                load_out[b.start[idx] as usize - c0 + mm] = ForceTorque {
                     force: fs,
-                    torque: r[0] * fs[1] - r[1] * fs[0],
+                    torque: [
+                        r[1] * fs[2] - r[2] * fs[1],
+                        r[2] * fs[0] - r[0] * fs[2],
+                        r[0] * fs[1] - r[1] * fs[0],
+                    ],
                 };
             }
         }
-        let out = &mut f_out[k * Q..(k + 1) * Q];
-        for i in 0..Q {
+        let out = &mut f_out[k * q..(k + 1) * q];
+        for i in 0..q {
             out[i] = T::from_f64(new[i]);
         }
-        if !b.limits.accepts(rho, [u[0], u[1], 0.0]) && first_bad.is_none() {
+        if !b.limits.accepts(rho, u) && first_bad.is_none() {
             first_bad = Some((idx, rho, u));
         }
         rho_out[k] = rho;
