@@ -40,8 +40,8 @@ pub struct CtxAa<'a, T, C> {
 #[inline(always)]
 fn check<T: Real, C, const B: usize>(ctx: &CtxAa<T, C>, m: &Moments<T, B>, idx0: usize, bad: &mut Bad) {
     let bits = ctx.limits.bad_lanes(&m.rho, &m.usq);
-    if bits != 0 && bad.is_none() {
-        *bad = first_bad(ctx, m, idx0, bits);
+    if bits != 0 {
+        keep_lowest_x(bad, first_bad(ctx, m, idx0, bits));
     }
     if let Some(o) = ctx.out {
         for w in 0..B {
@@ -54,6 +54,18 @@ fn check<T: Real, C, const B: usize>(ctx: &CtxAa<T, C>, m: &Moments<T, B>, idx0:
                 }
             }
         }
+    }
+}
+
+/// Keep the flagged node of lowest x of the row (rows are processed spans first, then periodic
+/// edges, then general nodes): the node the two-array stepper's row scan reports.
+#[cold]
+#[inline(never)]
+fn keep_lowest_x(bad: &mut Bad, cand: Bad) {
+    if let Some(c) = cand
+        && bad.is_none_or(|b| c.0 < b.0)
+    {
+        *bad = Some(c);
     }
 }
 
