@@ -40,7 +40,10 @@ fn crate_refs(text: &str) -> Vec<String> {
         let mut rest = code;
         while let Some(i) = rest.find("crate::") {
             let tail = &rest[i + 7..];
-            let name: String = tail.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+            let name: String = tail
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
             out.push(name);
             rest = &tail[1.min(tail.len())..];
         }
@@ -70,7 +73,10 @@ fn src_layers_import_only_downwards() {
             if let Some(l) = layer_of(&r)
                 && l > own
             {
-                bad.push(format!("{} imports crate::{r} (a layer above {module})", rel.display()));
+                bad.push(format!(
+                    "{} imports crate::{r} (a layer above {module})",
+                    rel.display()
+                ));
             }
         }
     }
@@ -80,7 +86,8 @@ fn src_layers_import_only_downwards() {
 
 #[test]
 fn the_contract_imports_nothing_from_the_crate() {
-    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/contract.rs")).unwrap();
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/contract.rs")).unwrap();
     assert!(crate_refs(&text).is_empty(), "{:?}", crate_refs(&text));
 }
 

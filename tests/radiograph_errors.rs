@@ -3,9 +3,9 @@
 use lbdem::contract::{Stage, StageContext};
 use lbdem::io::tiff::{write_u8, write_u16};
 use lbdem::stages::radiograph::{Params, Radiograph};
-use tiff::encoder::{TiffEncoder, colortype};
 use ndarray::Array2;
 use std::path::Path;
+use tiff::encoder::{TiffEncoder, colortype};
 
 fn frame(h: usize, w: usize, v: u16) -> Array2<u16> {
     Array2::from_shape_fn(

@@ -44,7 +44,10 @@ fn kill_and_resume(scene: &str, files: &[&str]) {
     assert!(err.contains("resuming at step"), "{err}");
     for f in files {
         let (x, y) = (read(&a, f), read(&b, f));
-        assert!(x == y, "{f} differs between the whole and the killed-and-resumed run");
+        assert!(
+            x == y,
+            "{f} differs between the whole and the killed-and-resumed run"
+        );
     }
     let manifest: serde_json::Value = serde_json::from_slice(&read(&b, "stage.json")).unwrap();
     assert_eq!(manifest["resumed"], true);
@@ -129,5 +132,28 @@ checkpoints = { every = 400 }
     kill_and_resume(
         scene,
         &["series.csv", "snapshots.csv", "snapshots/fluid_000012000.csv"],
+    );
+}
+
+#[test]
+fn grains_in_liquid_resume_bitwise_after_sigkill() {
+    let scene =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/coupled-float.toml"))
+            .unwrap()
+            .replace("steps = 1000", "steps = 600")
+            .replace(
+                "series = { every = 50 }",
+                "series = { every = 20 }\ncheckpoints = { every = 40 }",
+            )
+            .replace("snapshots = { every = 500 }", "snapshots = { every = 300 }");
+    kill_and_resume(
+        &scene,
+        &[
+            "series.csv",
+            "snapshots.csv",
+            "snapshots/fluid_000000600.csv",
+            "snapshots/particles_000000600.csv",
+            "snapshots/contacts_000000600.csv",
+        ],
     );
 }

@@ -80,7 +80,9 @@ fn build(sys: System) -> Result<Coupled<f64>> {
     let fluid = PsmFluid::<f64>::new(
         &domain,
         PsmSettings {
-            tau: units.lattice.tau,
+            collision: lbdem_lbm::Collision::Bgk {
+                tau: units.lattice.tau,
+            },
             force: [0.0; 2],
             limits: Limits::default(),
         },

@@ -2,12 +2,12 @@
 //! it marks masked pixels); writing encodes in memory and then writes atomically.
 
 use anyhow::{Context, Result, bail};
-use tiff::ColorType;
-use tiff::decoder::{Decoder, DecodingResult, Limits};
-use tiff::encoder::{Compression, DeflateLevel, TiffEncoder, colortype};
 use ndarray::{Array2, ArrayView2};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
+use tiff::ColorType;
+use tiff::decoder::{Decoder, DecodingResult, Limits};
+use tiff::encoder::{Compression, DeflateLevel, TiffEncoder, colortype};
 
 /// One frame read from a file: which file and page, and its pixels.
 #[derive(Clone, Debug)]

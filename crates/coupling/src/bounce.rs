@@ -15,6 +15,17 @@ use lbdem_lbm::collision::equilibrium;
 use lbdem_lbm::domain::{FLUID, NO_OBSTACLE, SOLID};
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Lattice, Limits, Macro, Motion, Real, Settings, Stepper};
 
+/// What a bounce-back lattice needs besides its settings to continue a run bit for bit
+/// (`BounceFluid::state`, `BounceFluid::restore`): the `Fluid` (post-collision populations, the
+/// domain with the grains' solid nodes and obstacle ids, the obstacle motions, the step) and the
+/// macroscopic fields of the last step.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
+pub struct BounceState<T: Real> {
+    pub fluid: Fluid<D2Q9, T>,
+    pub macro_fields: Macro,
+}
+
 /// A bounce-back lattice whose solid nodes follow the grains.
 pub struct BounceFluid<T: Real> {
     pub fluid: Fluid<D2Q9, T>,
@@ -47,6 +58,40 @@ impl<T: Real> BounceFluid<T> {
             was_solid: vec![false; n],
             owner: vec![NO_OBSTACLE; n],
         })
+    }
+
+    /// The state to checkpoint (see [`BounceState`]). Populations of non-fluid nodes are
+    /// never read (a node a grain uncovers is refilled) and hold whatever the two-array swap
+    /// left there, so they are written as 0: equal runs give equal states.
+    pub fn state(&self) -> BounceState<T> {
+        let mut fluid = self.fluid.clone();
+        let n = fluid.nodes();
+        for (idx, &k) in fluid.domain.kind.iter().enumerate() {
+            if k != FLUID {
+                for i in 0..D2Q9::Q {
+                    fluid.f[i * n + idx] = T::default();
+                }
+            }
+        }
+        BounceState {
+            fluid,
+            macro_fields: self.macro_fields.clone(),
+        }
+    }
+
+    /// Continue from `state` on a lattice built with the same box and settings.
+    pub fn restore(&mut self, state: BounceState<T>) -> Result<(), CouplingError> {
+        if state.fluid.domain.n != self.fluid.domain.n || state.fluid.f.len() != self.fluid.f.len() {
+            return Err(CouplingError::Unsupported(format!(
+                "bounce-back state of a {:?} box restored into a {:?} box: build the lattice with the \
+                 checkpoint's domain",
+                state.fluid.domain.n, self.fluid.domain.n
+            )));
+        }
+        self.fluid = state.fluid;
+        self.macro_fields = state.macro_fields;
+        self.stepper.rebuild(&self.fluid);
+        Ok(())
     }
 
     /// Mark the grains' nodes (lattice coordinates: node i at i + ½), refill uncovered nodes.

@@ -6,7 +6,7 @@
 //! sub-cycles is exactly F δt, the momentum the fluid lost in the LBM step.
 
 use crate::error::CouplingError;
-use crate::hydro::Hydro;
+use crate::hydro::{Hydro, HydroState};
 use crate::psm::{GrainMotion, Load};
 use crate::solid_fraction::GrainCircle;
 use crate::units::CouplingUnits;
@@ -21,6 +21,24 @@ pub struct Timing {
     pub dem: Duration,
     /// Solid map, grain motions, load conversion.
     pub coupling: Duration,
+}
+
+/// Everything a [`Coupled`] run reads from one cycle to the next besides its configuration
+/// (laws, step parameters, units, r_hd, depth, dry bodies, the interior-liquid switch, which
+/// the scene sets again): the DEM system, the held loads, the drivers' forces, the previous
+/// grain motions of the interior-liquid correction and the fluid's state. Restored into a run
+/// built the same way, it continues bit for bit (`tests/resume.rs`).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
+pub struct CoupledState<T: Real> {
+    pub sys: System,
+    /// Load of the last LBM cycle on each body (SI).
+    pub hydro: Vec<Load>,
+    pub user_force: Vec<Vec2>,
+    pub user_torque: Vec<f64>,
+    /// Grain motions (lattice units) at the start of the previous LBM cycle.
+    pub previous: Vec<GrainMotion>,
+    pub fluid: HydroState<T>,
 }
 
 /// A coupled LBM-DEM run: the lattice, the grains and the scratch of both engines.
@@ -256,6 +274,41 @@ impl<T: Real> Coupled<T> {
             p[1] += b.mass[k] * b.vel[k].y;
         }
         p
+    }
+
+    /// The state to checkpoint (see [`CoupledState`]).
+    pub fn state(&self) -> CoupledState<T> {
+        CoupledState {
+            sys: self.sys.clone(),
+            hydro: self.hydro.clone(),
+            user_force: self.user_force.clone(),
+            user_torque: self.user_torque.clone(),
+            previous: self.previous.clone(),
+            fluid: self.fluid.state(),
+        }
+    }
+
+    /// Continue from `state` in a run built with the same configuration. The DEM scratch starts
+    /// afresh (the DEM resumes bit for bit from its `System` alone).
+    pub fn restore(&mut self, state: CoupledState<T>) -> Result<(), CouplingError> {
+        let n = state.sys.bodies.len();
+        if state.hydro.len() != n || state.user_force.len() != n || state.user_torque.len() != n {
+            return Err(CouplingError::Unsupported(format!(
+                "coupled checkpoint with {n} bodies but {} loads and {} driver forces: the file is \
+                 inconsistent; write it again",
+                state.hydro.len(),
+                state.user_force.len()
+            )));
+        }
+        self.fluid.restore(state.fluid)?;
+        self.sys = state.sys;
+        self.hydro = state.hydro;
+        self.user_force = state.user_force;
+        self.user_torque = state.user_torque;
+        self.previous = state.previous;
+        self.dry.resize(n, false);
+        self.dem = Stepper::new();
+        Ok(())
     }
 
     /// The DEM stepper (its contact list of the last force evaluation).

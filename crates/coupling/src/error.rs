@@ -9,24 +9,14 @@ pub enum CouplingError {
     Tau { tau: f64 },
     #[error("unsupported set-up: {0}")]
     Unsupported(String),
-    #[error(
-        "LBM-DEM time-step ratio dt_lbm / dt_dem = {ratio} must be a whole number >= 1 \
-         (Su et al. 2020 Table 3); set dt_dem = dt_lbm / N for a whole N"
-    )]
-    Ratio { ratio: f64 },
-    #[error(
-        "coupled run unstable at LBM step {step}, node {node:?}: density {rho:.6}, velocity {u:?}; \
-         likely cause: {cause}"
-    )]
-    Unstable {
-        step: u64,
-        node: [usize; 2],
-        rho: f64,
-        u: [f64; 2],
-        cause: String,
-    },
+    /// Unit conversion refused (e.g. a DEM step that is not a whole fraction of the LBM step,
+    /// `UnitsError::Ratio`).
+    #[error(transparent)]
+    Units(#[from] lbdem_core::units::lattice::UnitsError),
     #[error(transparent)]
     Dem(#[from] lbdem_dem::DemError),
+    /// Every lattice failure, the instability of the PSM lattice included
+    /// (`LbmError::Unstable`: step, node, state and likely cause, from `lbdem_lbm::diagnosis`).
     #[error(transparent)]
     Lbm(#[from] lbdem_lbm::LbmError),
 }

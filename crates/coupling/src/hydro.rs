@@ -2,9 +2,9 @@
 //! switch between them on the same case: partially saturated cells (Su et al. 2020 Eqs. 9-14,
 //! the default) or moving-boundary bounce-back (Leonardi et al. 2014 Eqs. 19-21).
 
-use crate::bounce::BounceFluid;
+use crate::bounce::{BounceFluid, BounceState};
 use crate::error::CouplingError;
-use crate::psm::{GrainMotion, Load, PsmFluid};
+use crate::psm::{GrainMotion, Load, PsmFluid, PsmState};
 use crate::solid_fraction::{GrainCircle, SolidMap, solid_map};
 use lbdem_lbm::Real;
 use lbdem_lbm::lattice::CS2;
@@ -30,6 +30,16 @@ pub struct InteriorLiquid {
     pub polar: f64,
 }
 
+/// The checkpointed state of a [`Hydro`] (the PSM solid map is not part of it: the coupled loop
+/// recomputes it from the grains before every LBM step).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(bound = "", rename_all = "kebab-case")]
+#[allow(clippy::large_enum_variant)]
+pub enum HydroState<T: Real> {
+    Psm(PsmState<T>),
+    BounceBack(BounceState<T>),
+}
+
 /// One per run: the size difference between the variants does not matter.
 #[allow(clippy::large_enum_variant)]
 pub enum Hydro<T: Real> {
@@ -50,6 +60,27 @@ impl<T: Real> Hydro<T> {
             },
         }
     }
+    /// The state to checkpoint.
+    pub fn state(&self) -> HydroState<T> {
+        match self {
+            Hydro::Psm { fluid, .. } => HydroState::Psm(fluid.state()),
+            Hydro::BounceBack(b) => HydroState::BounceBack(b.state()),
+        }
+    }
+
+    /// Continue from `state` (same method, same box, same settings).
+    pub fn restore(&mut self, state: HydroState<T>) -> Result<(), CouplingError> {
+        match (self, state) {
+            (Hydro::Psm { fluid, .. }, HydroState::Psm(s)) => fluid.restore(s),
+            (Hydro::BounceBack(b), HydroState::BounceBack(s)) => b.restore(s),
+            (h, _) => Err(CouplingError::Unsupported(format!(
+                "checkpoint of the other coupling method restored into a {:?} run: use the \
+                 checkpoint's [coupling] method",
+                h.method()
+            ))),
+        }
+    }
+
     pub fn method(&self) -> Method {
         match self {
             Hydro::Psm { .. } => Method::Psm,
@@ -143,7 +174,8 @@ impl<T: Real> Hydro<T> {
         match self {
             Hydro::Psm { fluid, .. } => {
                 if fluid.is_active(idx) {
-                    (fluid.rho[idx], fluid.u[idx])
+                    let u = fluid.u[idx];
+                    (fluid.rho[idx], [u[0], u[1]])
                 } else {
                     (f64::NAN, [f64::NAN; 2])
                 }

@@ -20,10 +20,14 @@ pub mod hydro;
 pub mod overlap;
 pub mod psm;
 pub mod solid_fraction;
-pub mod units;
 pub mod weighting;
 
-pub use driver::Coupled;
+/// The units of a coupled run live in `lbdem_core::units::coupled` (the one units module);
+/// re-exported here so that `lbdem_coupling::units::CouplingUnits` keeps working.
+pub use lbdem_core::units::coupled as units;
+
+pub use bounce::{BounceFluid, BounceState};
+pub use driver::{Coupled, CoupledState};
 pub use error::CouplingError;
-pub use hydro::{Hydro, Method};
-pub use psm::{GrainMotion, Load, PsmFluid, PsmSettings};
+pub use hydro::{Hydro, HydroState, Method};
+pub use psm::{GrainMotion, Load, PsmFluid, PsmSettings, PsmState};

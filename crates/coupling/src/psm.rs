@@ -1,25 +1,36 @@
-//! The partially-saturated-cells (PSM) lattice: D2Q9 populations coupled to moving grains by
+//! The partially-saturated-cells (PSM) lattice: populations coupled to moving grains by
 //! the Noble-Torczynski collision (Su et al. 2020 Eqs. 9-11) and the hydrodynamic force and
-//! moment on each grain (Eq. 14).
+//! moment on each grain (Eq. 14). Written over the lattice (`PsmFluid<T, L>`, D2Q9 by default,
+//! D3Q19 too): the 2D API (`step` with `GrainMotion` and `Load`, `init_equilibrium`,
+//! `mass_momentum`) is D2Q9's; any lattice steps with `step_motions` (`lbdem_lbm::Motion`,
+//! `ForceTorque`). The solid-fraction map of `solid_fraction` (circle ∩ square cells) stays 2D:
+//! a 3D run brings its own `SolidMap` (cell index = node index x + nx (y + ny z)).
 //!
 //! Storage is array-of-structures (`f[node * 9 + i]`) so that rows of nodes are contiguous and
 //! can be handed to rayon tasks as plain slices; coupled grids are small (Su et al.: about
 //! 250 x 190 nodes) and the step is dominated by the DEM sub-cycles, so clarity wins here over
 //! the structure-of-arrays kernels of `lbdem-lbm`. Populations are stored in `T` (f64 or f32)
-//! and every update is computed in f64.
+//! and every update is computed in f64. The liquid part of the collision is the operator of
+//! `lbdem-lbm` (`lbdem_lbm::Collider`: BGK or TRT, uniform or with per-node τ), so the choice of
+//! collision is made in one place for every lattice.
 //!
 //! Determinism: rows are split into fixed chunks; each chunk writes its own slice of the
 //! population array and of the per-cover force buffer, and the per-grain sums run serially in
 //! cover order, so the result is bitwise the same for any number of threads.
 
 use crate::error::CouplingError;
-use crate::solid_fraction::SolidMap;
+use crate::solid_fraction::{CellCover, SolidMap};
 use crate::weighting::psm_weight;
+use lbdem_lbm::collision::{CollideParams, Collider, LocalRates, NodeRates, local_rates};
+use lbdem_lbm::lattice::QMAX;
 use lbdem_lbm::plan::{Upstream, neighbour};
-use lbdem_lbm::{D2Q9, Domain, Face, Lattice, Limits, Real};
+use lbdem_lbm::{
+    BadNode, Collision, D2Q9, Domain, Face, ForceTorque, Lattice, LbmError, Limits, Motion, Real,
+};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::marker::PhantomData;
 
-const Q: usize = 9;
 /// Rows per rayon task: fixed, so the split is the same for every pool size.
 const ROWS_PER_TASK: usize = 4;
 /// Marker bit of a pull source that is a bounce-back link (low bits: wall index).
@@ -27,7 +38,7 @@ const WALL: u32 = 1 << 31;
 
 /// Rigid motion of one grain in lattice units: centre (node i has its centre at i + ½),
 /// velocity and angular velocity (counter-clockwise positive).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct GrainMotion {
     pub centre: [f64; 2],
     pub velocity: [f64; 2],
@@ -46,73 +57,118 @@ impl GrainMotion {
 }
 
 /// Hydrodynamic force (x, y) and moment (z) on one grain, lattice units.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Load {
     pub force: [f64; 2],
     pub torque: f64,
 }
 
 /// Collision settings of a PSM lattice.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PsmSettings {
-    /// BGK relaxation time (Su Eq. 15: ν = c_s²(τ − ½)).
-    pub tau: f64,
+    /// The liquid collision (the operator of `lbdem-lbm`): BGK with τ (Su Eq. 15:
+    /// ν = c_s²(τ − ½)), or TRT with τ⁺ = τ and the magic Λ. τ also sets B of Eq. 10.
+    pub collision: Collision,
     /// Uniform body-force density on the liquid (Guo forcing, applied to the share 1 − B of
     /// each node), lattice units.
     pub force: [f64; 2],
     pub limits: Limits,
 }
 
-/// Populations and the streaming table of a 2D PSM lattice.
-pub struct PsmFluid<T: Real> {
+/// Populations and the streaming table of a PSM lattice (D2Q9 unless `L` says otherwise).
+pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
     pub nx: usize,
     pub ny: usize,
-    /// Post-collision populations of the current time, `f[node * 9 + i]`.
+    /// 1 in 2D.
+    pub nz: usize,
+    /// Post-collision populations of the current time, `f[node * Q + i]`.
     pub f: Vec<T>,
     other: Vec<T>,
     /// Pull source of population i at node x: index of the upstream node, or `WALL | w`.
     src: Vec<u32>,
     /// Wall velocities (index 0: stationary inactive nodes; 1 + face for box walls).
-    wall_u: Vec<[f64; 2]>,
+    wall_u: Vec<[f64; 3]>,
     /// Inactive nodes (outside the sample: the "solid zone" of Su Sect. 2.4) are never updated.
     active: Vec<bool>,
     settings: PsmSettings,
-    /// TRT magic parameter Λ = (τ⁺ − ½)(τ⁻ − ½) of the liquid collision, or `None` for BGK.
-    trt_magic: Option<f64>,
-    /// Density and velocity of every node after the last step.
+    /// Uniform collision constants (f64: every update is computed in f64).
+    params: CollideParams<f64>,
+    /// Per-node rates and the τ they came from (`set_local_tau`).
+    local: Option<(Vec<NodeRates<f64>>, Vec<f64>)>,
+    /// Density and velocity of every node after the last step (z = 0 in 2D).
     pub rho: Vec<f64>,
-    pub u: Vec<[f64; 2]>,
+    pub u: Vec<[f64; 3]>,
     /// Per cover of the last solid map: the load its grain received there.
-    cover_load: Vec<Load>,
+    cover_load: Vec<ForceTorque>,
+    /// The 2D `step`'s grains and loads in the lattice-independent form (scratch).
+    motions: Vec<Motion>,
+    loads3: Vec<ForceTorque>,
+    pub step: u64,
+    _l: PhantomData<L>,
+}
+
+/// What a PSM lattice needs besides its domain and settings to continue a run bit for bit
+/// (`PsmFluid::state`, `PsmFluid::restore`): the post-collision populations, the macroscopic
+/// fields of the last step (read by the coupling's outputs), the per-node τ if set, the step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(bound = "")]
+pub struct PsmState<T: Real> {
+    pub f: Vec<T>,
+    pub rho: Vec<f64>,
+    pub u: Vec<[f64; 3]>,
+    pub local_tau: Option<Vec<f64>>,
     pub step: u64,
 }
 
-/// Equilibrium of D2Q9 (Su Eq. 7).
+/// Equilibrium (Su Eq. 7, Leonardi Eq. 13).
 #[inline(always)]
-fn feq(i: usize, rho: f64, u: [f64; 2], usq: f64) -> f64 {
-    let c = D2Q9::C[i];
-    let cu = c[0] as f64 * u[0] + c[1] as f64 * u[1];
-    D2Q9::W[i] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * usq)
+fn feq<L: Lattice>(i: usize, rho: f64, u: [f64; 3], usq: f64) -> f64 {
+    let c = L::C[i];
+    let mut cu = c[0] as f64 * u[0] + c[1] as f64 * u[1];
+    if L::D == 3 {
+        cu += c[2] as f64 * u[2];
+    }
+    L::W[i] * rho * (1.0 + 3.0 * cu + 4.5 * cu * cu - 1.5 * usq)
 }
 
-impl<T: Real> PsmFluid<T> {
-    /// A fluid at rest with density 1 on the 2D `domain` (faces periodic or walls; nodes of
-    /// kind other than fluid are inactive and act as stationary bounce-back walls).
+/// |u|² over the lattice's dimensions (the 2D sum is the one of the 2D code).
+#[inline(always)]
+fn norm2<L: Lattice>(u: [f64; 3]) -> f64 {
+    let mut s = u[0] * u[0] + u[1] * u[1];
+    if L::D == 3 {
+        s += u[2] * u[2];
+    }
+    s
+}
+
+impl<T: Real, L: Lattice> PsmFluid<T, L> {
+    /// A fluid at rest with density 1 on `domain` (nz = 1 for D2Q9, nz > 1 for D3Q19; faces
+    /// periodic or walls; nodes of kind other than fluid are inactive and act as stationary
+    /// bounce-back walls).
     pub fn new(domain: &Domain, settings: PsmSettings) -> Result<Self, CouplingError> {
         let [nx, ny, nz] = domain.n;
-        if nz != 1 {
+        if (L::D == 2) != (nz == 1) {
             return Err(CouplingError::Unsupported(format!(
-                "the PSM coupling is 2D (D2Q9); the domain has nz = {nz}, set it to 1"
+                "PSM lattice {} on a box of {nx} x {ny} x {nz} nodes: use nz = 1 with D2Q9 and nz > 1 \
+                 with D3Q19",
+                L::NAME
             )));
         }
-        if !(settings.tau > 0.5 && settings.tau.is_finite()) {
-            return Err(CouplingError::Tau { tau: settings.tau });
+        let tau = settings.collision.tau();
+        if !(tau > 0.5 && tau.is_finite()) {
+            return Err(CouplingError::Tau { tau });
         }
-        let mut wall_u = vec![[0.0; 2]];
+        let params =
+            CollideParams::<f64>::new(&settings.collision, [settings.force[0], settings.force[1], 0.0])?;
+        let mut wall_u = vec![[0.0; 3]];
         for face in &domain.faces {
             match face {
-                Face::Periodic => wall_u.push([0.0; 2]),
-                Face::Wall { velocity } => wall_u.push([velocity[0], velocity[1]]),
+                Face::Periodic => wall_u.push([0.0; 3]),
+                Face::Wall { velocity } => wall_u.push(if L::D == 3 {
+                    *velocity
+                } else {
+                    [velocity[0], velocity[1], 0.0]
+                }),
                 other => {
                     return Err(CouplingError::Unsupported(format!(
                         "face {other:?}: the PSM lattice takes periodic faces or walls only"
@@ -120,46 +176,50 @@ impl<T: Real> PsmFluid<T> {
                 }
             }
         }
-        let n = nx * ny;
+        let n = nx * ny * nz;
+        let q = L::Q;
         let active: Vec<bool> = domain
             .kind
             .iter()
             .map(|&k| k == lbdem_lbm::domain::FLUID)
             .collect();
-        let mut src = vec![0u32; n * Q];
-        for y in 0..ny {
-            for x in 0..nx {
-                let idx = x + nx * y;
-                for i in 0..Q {
-                    let c = D2Q9::C[i];
-                    src[idx * Q + i] = match neighbour(domain, [x, y, 0], [-c[0], -c[1], 0]) {
-                        Upstream::Node(j) if active[j] => j as u32,
-                        Upstream::Node(_) => WALL,
-                        Upstream::Face(f) => WALL | (1 + f as u32),
-                    };
-                }
+        let mut src = vec![0u32; n * q];
+        for idx in 0..n {
+            let p = domain.coords(idx);
+            for i in 0..q {
+                let c = L::C[i];
+                src[idx * q + i] = match neighbour(domain, p, [-c[0], -c[1], -c[2]]) {
+                    Upstream::Node(j) if active[j] => j as u32,
+                    Upstream::Node(_) => WALL,
+                    Upstream::Face(f) => WALL | (1 + f as u32),
+                };
             }
         }
-        let mut f = vec![T::default(); n * Q];
-        for node in f.chunks_exact_mut(Q) {
-            for i in 0..Q {
-                node[i] = T::from_f64(D2Q9::W[i]);
+        let mut f = vec![T::default(); n * q];
+        for node in f.chunks_exact_mut(q) {
+            for i in 0..q {
+                node[i] = T::from_f64(L::W[i]);
             }
         }
         Ok(Self {
             nx,
             ny,
+            nz,
             other: f.clone(),
             f,
             src,
             wall_u,
             active,
             settings,
-            trt_magic: None,
+            params,
+            local: None,
             rho: vec![1.0; n],
-            u: vec![[0.0; 2]; n],
+            u: vec![[0.0; 3]; n],
             cover_load: Vec::new(),
+            motions: Vec::new(),
+            loads3: Vec::new(),
             step: 0,
+            _l: PhantomData,
         })
     }
 
@@ -168,64 +228,130 @@ impl<T: Real> PsmFluid<T> {
     /// Λ = (τ − ½)²: near τ = ½ (settling pairs at Reynolds numbers of hundreds) that is about
     /// 1e-4, the odd rate is close to 2 and the odd non-equilibrium flips sign every step and
     /// barely decays; Λ = 1/4 damps it. The solid term (Eq. 11) and the weight B (Eq. 10, from
-    /// τ⁺) are unchanged.
+    /// τ⁺) are unchanged. The same as `PsmSettings::collision = Collision::Trt { tau, magic }`.
     pub fn with_trt(mut self, magic: f64) -> Result<Self, CouplingError> {
-        if !(magic > 0.0 && magic.is_finite()) {
-            return Err(CouplingError::Unsupported(format!(
-                "TRT magic parameter {magic} must be positive and finite (1/4 is the usual choice)"
-            )));
+        let collision = Collision::Trt {
+            tau: self.settings.collision.tau(),
+            magic,
+        };
+        let force = [self.settings.force[0], self.settings.force[1], 0.0];
+        self.params = CollideParams::new(&collision, force)?;
+        self.settings.collision = collision;
+        if let Some((_, tau)) = self.local.take() {
+            self.set_local_tau(tau)?;
         }
-        self.trt_magic = Some(magic);
         Ok(self)
     }
 
-    /// Set every node to the equilibrium of density `rho` and velocity `u(x, y)`.
-    pub fn init_equilibrium(&mut self, init: impl Fn(usize, usize) -> (f64, [f64; 2])) {
-        for idx in 0..self.nx * self.ny {
-            let (rho, u) = init(idx % self.nx, idx / self.nx);
-            let usq = u[0] * u[0] + u[1] * u[1];
-            for i in 0..Q {
-                self.f[idx * Q + i] = T::from_f64(feq(i, rho, u, usq));
+    /// Relax node x with τ⁺ = `tau[x]` (node order x + nx y) instead of the settings' τ, with the
+    /// settings' kind of collision; B of Eq. 10 then takes the local τ too. The seam of local-τ
+    /// rheology (Bingham, Leonardi et al. 2014 Eq. 8). Equal values everywhere give the uniform
+    /// run bit for bit.
+    pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), CouplingError> {
+        let nodes = self.nodes();
+        if tau.len() != nodes {
+            return Err(LbmError::LocalTauLength {
+                got: tau.len(),
+                nodes,
             }
-            self.rho[idx] = rho;
-            self.u[idx] = u;
+            .into());
+        }
+        let (rates, bgk) = local_rates::<f64>(&self.settings.collision, &tau)?;
+        self.params.bgk = bgk;
+        self.local = Some((rates, tau));
+        Ok(())
+    }
+
+    /// Back to the settings' uniform τ.
+    pub fn clear_local_tau(&mut self) {
+        self.local = None;
+        let (wp, wm) = (self.params.omega_p, self.params.omega_m);
+        self.params.bgk = wp == wm;
+    }
+
+    /// The state to checkpoint (see [`PsmState`]).
+    pub fn state(&self) -> PsmState<T> {
+        PsmState {
+            f: self.f.clone(),
+            rho: self.rho.clone(),
+            u: self.u.clone(),
+            local_tau: self.local.as_ref().map(|(_, t)| t.clone()),
+            step: self.step,
         }
     }
 
-    /// Total mass and momentum of the populations (lattice units).
-    pub fn mass_momentum(&self) -> (f64, [f64; 2]) {
-        let (mut m, mut j) = (0.0, [0.0; 2]);
-        for (node, a) in self.f.chunks_exact(Q).zip(&self.active) {
+    /// Continue from `state` on a lattice built with the same domain and settings.
+    pub fn restore(&mut self, state: PsmState<T>) -> Result<(), CouplingError> {
+        let n = self.nodes();
+        if state.f.len() != n * L::Q || state.rho.len() != n || state.u.len() != n {
+            return Err(CouplingError::Unsupported(format!(
+                "PSM state of {} populations and {} nodes for a lattice of {} x {} nodes: restore into \
+                 a lattice built with the checkpoint's domain",
+                state.f.len(),
+                state.rho.len(),
+                self.nx,
+                self.ny
+            )));
+        }
+        match state.local_tau {
+            Some(t) => self.set_local_tau(t)?,
+            None => self.clear_local_tau(),
+        }
+        self.f = state.f;
+        self.rho = state.rho;
+        self.u = state.u;
+        self.step = state.step;
+        Ok(())
+    }
+
+    /// Nodes of the lattice.
+    pub fn nodes(&self) -> usize {
+        self.nx * self.ny * self.nz
+    }
+
+    /// Total mass and momentum of the populations of the active nodes (lattice units).
+    pub fn mass_momentum3(&self) -> (f64, [f64; 3]) {
+        let q = L::Q;
+        let (mut m, mut j) = (0.0, [0.0; 3]);
+        for (node, a) in self.f.chunks_exact(q).zip(&self.active) {
             if !a {
                 continue;
             }
-            for i in 0..Q {
+            for i in 0..q {
                 let v = node[i].to_f64();
                 m += v;
-                j[0] += v * D2Q9::C[i][0] as f64;
-                j[1] += v * D2Q9::C[i][1] as f64;
+                j[0] += v * L::C[i][0] as f64;
+                j[1] += v * L::C[i][1] as f64;
+                if L::D == 3 {
+                    j[2] += v * L::C[i][2] as f64;
+                }
             }
         }
         (m, j)
     }
 
-    /// One LBM step: pull-stream, then collide with the PSM term of every grain covering each
-    /// node (Su Eq. 9, per-grain weights B_s = B ε_s / ε so that Σ_s B_s = B of Eq. 10), and
-    /// return the load on each of `grains.len()` grains (Eq. 14, summed over the grain's
-    /// circles because the map holds one cover per grain and cell).
+    /// One LBM step on any lattice: pull-stream, then collide with the PSM term of every grain
+    /// covering each node (Su Eq. 9, per-grain weights B_s = B ε_s / ε so that Σ_s B_s = B of
+    /// Eq. 10), and return the force and moment on each of `grains.len()` grains (Eq. 14, summed
+    /// over the grain's cells). Grain centres are in lattice coordinates with node i at i + ½
+    /// (z = 0 in 2D); the map's cell index is the node index.
     ///
     /// The force on a grain is the reaction to the momentum its solid term puts into the
     /// fluid: F_s = −Σ_x B_s Σ_i Ω_i^s c_i (Su writes Eq. 14 as the momentum transfer; the
     /// sign here makes fluid plus grains conserve momentum, which a test checks).
-    pub fn step(
+    pub fn step_motions(
         &mut self,
         map: &SolidMap,
-        grains: &[GrainMotion],
-        loads: &mut Vec<Load>,
+        grains: &[Motion],
+        loads: &mut Vec<ForceTorque>,
     ) -> Result<(), CouplingError> {
-        let (nx, ny) = (self.nx, self.ny);
-        assert_eq!((map.nx, map.ny), (nx, ny), "solid map and lattice differ in size");
-        let n = nx * ny;
+        let (nx, ny, nz) = (self.nx, self.ny, self.nz);
+        let n = self.nodes();
+        assert!(
+            (map.nx, map.ny) == (nx, ny) && map.total.len() == n,
+            "solid map and lattice differ in size"
+        );
+        let q = L::Q;
         // Covers of cell c are covers[start[c]..start[c + 1]] (the map is sorted by cell).
         let mut start = vec![0u32; n + 1];
         for cv in &map.covers {
@@ -235,23 +361,26 @@ impl<T: Real> PsmFluid<T> {
             start[c + 1] += start[c];
         }
         self.cover_load.clear();
-        self.cover_load.resize(map.covers.len(), Load::default());
+        self.cover_load.resize(map.covers.len(), ForceTorque::default());
 
-        let tau = self.settings.tau;
-        let omega = 1.0 / tau;
-        // Odd-moment rate: equal to ω for BGK, from Λ for TRT.
-        let omega_odd = match self.trt_magic {
-            None => omega,
-            Some(l) => 1.0 / (0.5 + l / (tau - 0.5)),
-        };
-        let trt = self.trt_magic.is_some();
-        let force = self.settings.force;
+        let forced = self.settings.force.iter().any(|&x| x != 0.0);
         let limits = self.settings.limits;
         let step = self.step;
-        let f_in = &self.f;
-        let src = &self.src;
-        let wall_u = &self.wall_u;
-        let active = &self.active;
+        let base = Base {
+            nx,
+            ny,
+            nz,
+            f_in: &self.f,
+            src: &self.src,
+            wall_u: &self.wall_u,
+            active: &self.active,
+            map,
+            start: &start,
+            grains,
+            tau: self.settings.collision.tau(),
+            local_tau: self.local.as_ref().map(|(_, t)| t.as_slice()),
+            limits,
+        };
 
         // Split every per-node and per-cover output into the same fixed row chunks.
         let rows_chunk = ROWS_PER_TASK * nx;
@@ -259,17 +388,23 @@ impl<T: Real> PsmFluid<T> {
         {
             let mut f_out: &mut [T] = &mut self.other;
             let mut rho: &mut [f64] = &mut self.rho;
-            let mut u: &mut [[f64; 2]] = &mut self.u;
-            let mut loads_rest: &mut [Load] = &mut self.cover_load;
+            let mut u: &mut [[f64; 3]] = &mut self.u;
+            let mut loads_rest: &mut [ForceTorque] = &mut self.cover_load;
             let mut node0 = 0;
             while node0 < n {
                 let len = rows_chunk.min(n - node0);
-                let (fa, fb) = std::mem::take(&mut f_out).split_at_mut(len * Q);
+                let (fa, fb) = std::mem::take(&mut f_out).split_at_mut(len * q);
                 let (ra, rb) = std::mem::take(&mut rho).split_at_mut(len);
                 let (ua, ub) = std::mem::take(&mut u).split_at_mut(len);
                 let nc = (start[node0 + len] - start[node0]) as usize;
                 let (la, lb) = std::mem::take(&mut loads_rest).split_at_mut(nc);
-                tasks.push((node0, fa, ra, ua, la));
+                tasks.push(Chunk {
+                    node0,
+                    f_out: fa,
+                    rho: ra,
+                    u: ua,
+                    loads: la,
+                });
                 f_out = fb;
                 rho = rb;
                 u = ub;
@@ -277,159 +412,107 @@ impl<T: Real> PsmFluid<T> {
                 node0 += len;
             }
         }
-        let bad = tasks
-            .into_par_iter()
-            .map(|(node0, f_out, rho_out, u_out, load_out)| {
-                let c0 = start[node0] as usize;
-                let mut first_bad = None;
-                for k in 0..rho_out.len() {
-                    let idx = node0 + k;
-                    let out = &mut f_out[k * Q..(k + 1) * Q];
-                    if !active[idx] {
-                        continue;
-                    }
-                    // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes.
-                    let mut f = [0.0; Q];
-                    for i in 0..Q {
-                        let s = src[idx * Q + i];
-                        f[i] = if s & WALL == 0 {
-                            f_in[s as usize * Q + i].to_f64()
-                        } else {
-                            let uw = wall_u[(s & !WALL) as usize];
-                            let c = D2Q9::C[i];
-                            let o = D2Q9::OPP[i];
-                            f_in[idx * Q + o].to_f64()
-                                + 6.0 * D2Q9::W[i] * (c[0] as f64 * uw[0] + c[1] as f64 * uw[1])
-                        };
-                    }
-                    // Moments (Su Eq. 13) with the Guo half-force shift.
-                    let mut rho = 0.0;
-                    let mut j = [0.0; 2];
-                    for i in 0..Q {
-                        rho += f[i];
-                        j[0] += f[i] * D2Q9::C[i][0] as f64;
-                        j[1] += f[i] * D2Q9::C[i][1] as f64;
-                    }
-                    let u = [(j[0] + 0.5 * force[0]) / rho, (j[1] + 0.5 * force[1]) / rho];
-                    let usq = u[0] * u[0] + u[1] * u[1];
-                    let mut fe = [0.0; Q];
-                    for i in 0..Q {
-                        fe[i] = feq(i, rho, u, usq);
-                    }
-                    // Fluid part of Eq. 9 plus the Guo source (Leonardi Eq. 16) on the liquid share 1 − B:
-                    // with u shifted by F/2 this puts exactly (1 − B) F of momentum into the node.
-                    let cover = &map.covers[start[idx] as usize..start[idx + 1] as usize];
-                    let eps = map.total[idx];
-                    let b = if cover.is_empty() {
-                        0.0
-                    } else {
-                        psm_weight(eps, tau)
-                    };
-                    let mut post = [0.0; Q];
-                    let mut src_term = [0.0; Q];
-                    for i in 0..Q {
-                        let c = D2Q9::C[i];
-                        let cu = c[0] as f64 * u[0] + c[1] as f64 * u[1];
-                        let s = D2Q9::W[i]
-                            * ((3.0 * (c[0] as f64 - u[0]) + 9.0 * cu * c[0] as f64) * force[0]
-                                + (3.0 * (c[1] as f64 - u[1]) + 9.0 * cu * c[1] as f64) * force[1]);
-                        post[i] = if trt {
-                            0.0 // filled below from the even and odd parts
-                        } else {
-                            f[i] - (1.0 - b) * omega * (f[i] - fe[i]) + (1.0 - b) * (1.0 - 0.5 * omega) * s
-                        };
-                        src_term[i] = s;
-                    }
-                    if trt {
-                        for i in 0..Q {
-                            let o = D2Q9::OPP[i];
-                            let (ne_even, ne_odd) = (
-                                0.5 * ((f[i] - fe[i]) + (f[o] - fe[o])),
-                                0.5 * ((f[i] - fe[i]) - (f[o] - fe[o])),
-                            );
-                            let (s_even, s_odd) = (
-                                0.5 * (src_term[i] + src_term[o]),
-                                0.5 * (src_term[i] - src_term[o]),
-                            );
-                            post[i] = f[i] - (1.0 - b) * (omega * ne_even + omega_odd * ne_odd)
-                                + (1.0 - b)
-                                    * ((1.0 - 0.5 * omega) * s_even + (1.0 - 0.5 * omega_odd) * s_odd);
-                        }
-                    }
-                    // Solid part: Ω of Eq. 11 for each covering grain, weighted by B_s.
-                    let x = [(idx % nx) as f64 + 0.5, (idx / nx) as f64 + 0.5];
-                    for (m, cv) in cover.iter().enumerate() {
-                        let bs = b * cv.fraction / eps;
-                        let g = &grains[cv.body as usize];
-                        let r = min_image(x, g.centre, nx, ny);
-                        let us = g.velocity_at(r);
-                        let ussq = us[0] * us[0] + us[1] * us[1];
-                        let mut p = [0.0; 2];
-                        for i in 0..Q {
-                            let o = D2Q9::OPP[i];
-                            let om = f[o] - f[i] + feq(i, rho, us, ussq) - fe[o];
-                            post[i] += bs * om;
-                            p[0] += bs * om * D2Q9::C[i][0] as f64;
-                            p[1] += bs * om * D2Q9::C[i][1] as f64;
-                        }
-                        let fs = [-p[0], -p[1]];
-                        load_out[start[idx] as usize - c0 + m] = Load {
-                            force: fs,
-                            torque: r[0] * fs[1] - r[1] * fs[0],
-                        };
-                    }
-                    for i in 0..Q {
-                        out[i] = T::from_f64(post[i]);
-                    }
-                    let speed = usq.sqrt();
-                    let ok = rho.is_finite()
-                        && speed.is_finite()
-                        && rho > limits.rho_min
-                        && rho < limits.rho_max
-                        && speed < limits.u_max;
-                    if !ok && first_bad.is_none() {
-                        first_bad = Some((idx, rho, u));
-                    }
-                    rho_out[k] = rho;
-                    u_out[k] = u;
-                }
-                first_bad
-            })
-            .collect::<Vec<_>>()
-            .into_iter()
-            .flatten()
-            .next();
+        let params = self.params;
+        let bad = match &self.local {
+            None => run_chunks::<T, L, _>(&base, params, tasks, forced),
+            Some((rates, _)) => {
+                run_chunks::<T, L, _>(&base, LocalRates { base: params, rates }, tasks, forced)
+            }
+        };
         if let Some((idx, rho, u)) = bad {
-            return Err(CouplingError::Unstable {
+            let tau = match &self.local {
+                Some((_, t)) => t[idx],
+                None => self.settings.collision.tau(),
+            };
+            let bad = BadNode {
                 step: step + 1,
-                node: [idx % nx, idx / nx],
+                node: [idx % nx, (idx / nx) % ny, idx / (nx * ny)],
                 rho,
                 u,
-                cause: diagnose(rho, u, tau, &limits),
-            });
+                tau,
+            };
+            return Err(CouplingError::Lbm(bad.into_error(&limits)));
         }
         std::mem::swap(&mut self.f, &mut self.other);
         self.step += 1;
 
         loads.clear();
-        loads.resize(grains.len(), Load::default());
+        loads.resize(grains.len(), ForceTorque::default());
         for (cv, l) in map.covers.iter().zip(&self.cover_load) {
             let t = &mut loads[cv.body as usize];
-            t.force[0] += l.force[0];
-            t.force[1] += l.force[1];
-            t.torque += l.torque;
+            for a in 0..3 {
+                t.force[a] += l.force[a];
+                t.torque[a] += l.torque[a];
+            }
         }
         Ok(())
     }
 
     /// BGK relaxation time (TRT: the even one, τ⁺), which sets the viscosity and B of Eq. 10.
     pub fn tau(&self) -> f64 {
-        self.settings.tau
+        self.settings.collision.tau()
+    }
+
+    /// The settings the lattice was built with (the collision after `with_trt`).
+    pub fn settings(&self) -> &PsmSettings {
+        &self.settings
     }
 
     /// Whether node `idx` is updated (not in the inactive zone).
     pub fn is_active(&self, idx: usize) -> bool {
         self.active[idx]
+    }
+}
+
+/// The 2D API (grains as `GrainMotion`, loads as `Load`).
+impl<T: Real> PsmFluid<T, D2Q9> {
+    /// Set every node to the equilibrium of density `rho` and velocity `u(x, y)`.
+    pub fn init_equilibrium(&mut self, init: impl Fn(usize, usize) -> (f64, [f64; 2])) {
+        let q = D2Q9::Q;
+        for idx in 0..self.nx * self.ny {
+            let (rho, u) = init(idx % self.nx, idx / self.nx);
+            let u = [u[0], u[1], 0.0];
+            let usq = norm2::<D2Q9>(u);
+            for i in 0..q {
+                self.f[idx * q + i] = T::from_f64(feq::<D2Q9>(i, rho, u, usq));
+            }
+            self.rho[idx] = rho;
+            self.u[idx] = u;
+        }
+    }
+
+    /// Total mass and momentum of the populations (lattice units).
+    pub fn mass_momentum(&self) -> (f64, [f64; 2]) {
+        let (m, j) = self.mass_momentum3();
+        (m, [j[0], j[1]])
+    }
+
+    /// One LBM step with the grains' 2D motions; the load on each of `grains.len()` grains
+    /// (Eq. 14, summed over the grain's circles because the map holds one cover per grain and
+    /// cell). See [`PsmFluid::step_motions`].
+    pub fn step(
+        &mut self,
+        map: &SolidMap,
+        grains: &[GrainMotion],
+        loads: &mut Vec<Load>,
+    ) -> Result<(), CouplingError> {
+        let mut motions = std::mem::take(&mut self.motions);
+        let mut loads3 = std::mem::take(&mut self.loads3);
+        motions.clear();
+        motions.extend(grains.iter().map(|g| Motion {
+            centre: [g.centre[0], g.centre[1], 0.0],
+            velocity: [g.velocity[0], g.velocity[1], 0.0],
+            omega: [0.0, 0.0, g.omega],
+        }));
+        let r = self.step_motions(map, &motions, &mut loads3);
+        loads.clear();
+        loads.extend(loads3.iter().map(|l| Load {
+            force: [l.force[0], l.force[1]],
+            torque: l.torque[2],
+        }));
+        self.motions = motions;
+        self.loads3 = loads3;
+        r
     }
 }
 
@@ -448,16 +531,206 @@ pub(crate) fn min_image(x: [f64; 2], c: [f64; 2], nx: usize, ny: usize) -> [f64;
     d
 }
 
-fn diagnose(rho: f64, u: [f64; 2], tau: f64, limits: &Limits) -> String {
-    let speed = (u[0] * u[0] + u[1] * u[1]).sqrt();
-    if !rho.is_finite() || !speed.is_finite() {
-        format!("non-finite state; tau = {tau} is too close to 0.5 or the grains move too fast for dt")
-    } else if speed >= limits.u_max {
-        format!(
-            "velocity {speed:.3} (lattice) above {}: Mach too high; reduce the LBM time step",
-            limits.u_max
-        )
-    } else {
-        "density out of range: pressure waves too strong; reduce the LBM time step or the grain speed".into()
+/// Offset x − c with the minimum-image convention on a periodic box (the 2D arithmetic of
+/// `min_image` for x and y; z only in 3D).
+#[inline]
+fn min_image3<L: Lattice>(x: [f64; 3], c: [f64; 3], n: [usize; 3]) -> [f64; 3] {
+    let d = min_image([x[0], x[1]], [c[0], c[1]], n[0], n[1]);
+    let mut z = 0.0;
+    if L::D == 3 {
+        let l = n[2] as f64;
+        z = x[2] - c[2];
+        if z > 0.5 * l {
+            z -= l;
+        } else if z < -0.5 * l {
+            z += l;
+        }
     }
+    [d[0], d[1], z]
+}
+
+/// Velocity of a grain's material at offset `r`: v + ω × r (Leonardi Eq. 20); in 2D the
+/// expression of `GrainMotion::velocity_at`.
+#[inline]
+fn velocity_at<L: Lattice>(g: &Motion, r: [f64; 3]) -> [f64; 3] {
+    if L::D == 3 {
+        g.velocity_at(r)
+    } else {
+        let w = g.omega[2];
+        [g.velocity[0] - w * r[1], g.velocity[1] + w * r[0], 0.0]
+    }
+}
+
+/// What every chunk of a step reads.
+struct Base<'a, T> {
+    nx: usize,
+    ny: usize,
+    nz: usize,
+    f_in: &'a [T],
+    src: &'a [u32],
+    wall_u: &'a [[f64; 3]],
+    active: &'a [bool],
+    map: &'a SolidMap,
+    start: &'a [u32],
+    grains: &'a [Motion],
+    tau: f64,
+    local_tau: Option<&'a [f64]>,
+    limits: Limits,
+}
+
+/// The nodes [node0, node0 + rho.len()) of one task and its share of the outputs.
+struct Chunk<'a, T> {
+    node0: usize,
+    f_out: &'a mut [T],
+    rho: &'a mut [f64],
+    u: &'a mut [[f64; 3]],
+    loads: &'a mut [ForceTorque],
+}
+
+/// Every chunk on the rayon pool with the liquid collision `C`; the first node outside the
+/// limits (node order), if any: (node, ρ, u).
+fn run_chunks<T: Real, L: Lattice, C: Collider<L, f64>>(
+    base: &Base<T>,
+    coll: C,
+    tasks: Vec<Chunk<T>>,
+    forced: bool,
+) -> Option<(usize, f64, [f64; 3])> {
+    tasks
+        .into_par_iter()
+        .map(|c| {
+            if forced {
+                chunk::<T, L, C, true>(base, &coll, c)
+            } else {
+                chunk::<T, L, C, false>(base, &coll, c)
+            }
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .flatten()
+        .next()
+}
+
+/// One chunk of nodes: pull-stream (Su Eq. 12) with bounce-back from walls and inactive nodes,
+/// then the PSM collision of Su Eq. 9,
+///
+///   f_i⁺ = f_i + (1 − B)(C(f)_i − f_i) + Σ_s B_s Ω_i^s,
+///
+/// where C is the liquid collision of `lbdem-lbm` (BGK, Su Eq. 9 with B = 0, or TRT, with the
+/// Guo source of Leonardi Eq. 16 and u = (Σ f c + F/2)/ρ, Su Eq. 13 / Leonardi Eq. 17: with B the
+/// node receives exactly (1 − B) F of momentum), B from Eq. 10, B_s = B ε_s / ε so that
+/// Σ_s B_s = B, and Ω^s the solid term of Eq. 11. The load on grain s is the reaction to the
+/// momentum Ω^s puts into the liquid (Eq. 14).
+fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
+    b: &Base<T>,
+    coll: &C,
+    out: Chunk<T>,
+) -> Option<(usize, f64, [f64; 3])> {
+    let q = L::Q;
+    let Chunk {
+        node0,
+        f_out,
+        rho: rho_out,
+        u: u_out,
+        loads: load_out,
+    } = out;
+    let c0 = b.start[node0] as usize;
+    let mut first_bad = None;
+    for k in 0..rho_out.len() {
+        let idx = node0 + k;
+        if !b.active[idx] {
+            continue;
+        }
+        // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes (Leonardi Eq. 19).
+        let mut f = [0.0; QMAX];
+        for i in 0..q {
+            let s = b.src[idx * q + i];
+            f[i] = if s & WALL == 0 {
+                b.f_in[s as usize * q + i].to_f64()
+            } else {
+                let uw = b.wall_u[(s & !WALL) as usize];
+                let c = L::C[i];
+                let o = L::OPP[i];
+                let mut cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1];
+                if L::D == 3 {
+                    cu += c[2] as f64 * uw[2];
+                }
+                b.f_in[idx * q + o].to_f64() + 6.0 * L::W[i] * cu
+            };
+        }
+        // The liquid collision C(f) and the moments it used.
+        let mut post = [[0.0; 1]; QMAX];
+        for i in 0..q {
+            post[i][0] = f[i];
+        }
+        let m = C::collide::<1, F>(coll, &mut post, idx);
+        let rho = m.rho[0];
+        let u = [m.u[0][0], m.u[1][0], m.u[2][0]];
+        let cover: &[CellCover] = &b.map.covers[b.start[idx] as usize..b.start[idx + 1] as usize];
+        let mut new = [0.0; QMAX];
+        if cover.is_empty() {
+            // B = 0: Eq. 9 is the liquid collision alone
+            for i in 0..q {
+                new[i] = post[i][0];
+            }
+        } else {
+            let eps = b.map.total[idx];
+            let tau = b.local_tau.map_or(b.tau, |t| t[idx]);
+            let weight = psm_weight(eps, tau);
+            for i in 0..q {
+                new[i] = f[i] + (1.0 - weight) * (post[i][0] - f[i]);
+            }
+            let usq = norm2::<L>(u);
+            let mut fe = [0.0; QMAX];
+            for i in 0..q {
+                fe[i] = feq::<L>(i, rho, u, usq);
+            }
+            // Solid part: Ω of Eq. 11 for each covering grain, weighted by B_s.
+            let x = [
+                (idx % b.nx) as f64 + 0.5,
+                ((idx / b.nx) % b.ny) as f64 + 0.5,
+                if L::D == 3 {
+                    (idx / (b.nx * b.ny)) as f64 + 0.5
+                } else {
+                    0.0
+                },
+            ];
+            for (mm, cv) in cover.iter().enumerate() {
+                let bs = weight * cv.fraction / eps;
+                let g = &b.grains[cv.body as usize];
+                let r = min_image3::<L>(x, g.centre, [b.nx, b.ny, b.nz]);
+                let us = velocity_at::<L>(g, r);
+                let ussq = norm2::<L>(us);
+                let mut p = [0.0; 3];
+                for i in 0..q {
+                    let o = L::OPP[i];
+                    let om = f[o] - f[i] + feq::<L>(i, rho, us, ussq) - fe[o];
+                    new[i] += bs * om;
+                    p[0] += bs * om * L::C[i][0] as f64;
+                    p[1] += bs * om * L::C[i][1] as f64;
+                    if L::D == 3 {
+                        p[2] += bs * om * L::C[i][2] as f64;
+                    }
+                }
+                let fs = [-p[0], -p[1], -p[2]];
+                load_out[b.start[idx] as usize - c0 + mm] = ForceTorque {
+                    force: fs,
+                    torque: [
+                        r[1] * fs[2] - r[2] * fs[1],
+                        r[2] * fs[0] - r[0] * fs[2],
+                        r[0] * fs[1] - r[1] * fs[0],
+                    ],
+                };
+            }
+        }
+        let out = &mut f_out[k * q..(k + 1) * q];
+        for i in 0..q {
+            out[i] = T::from_f64(new[i]);
+        }
+        if !b.limits.accepts(rho, u) && first_bad.is_none() {
+            first_bad = Some((idx, rho, u));
+        }
+        rho_out[k] = rho;
+        u_out[k] = u;
+    }
+    first_bad
 }

@@ -23,7 +23,7 @@ fn build() -> Coupled<f64> {
     let fluid = PsmFluid::<f64>::new(
         &Domain::periodic([n, n, 1]),
         PsmSettings {
-            tau: 1.0,
+            collision: lbdem_lbm::Collision::Bgk { tau: 1.0 },
             force: [0.0; 2],
             limits: Limits::default(),
         },

@@ -28,7 +28,7 @@ fn torque(bounce_back: bool) -> (f64, f64) {
             PsmFluid::new(
                 &dom,
                 PsmSettings {
-                    tau,
+                    collision: lbdem_lbm::Collision::Bgk { tau },
                     force: [0.0; 2],
                     limits,
                 },

@@ -16,6 +16,4 @@ pub mod synth;
 
 pub use error::ImagingError;
 pub use roi::Roi;
-/// Re-exported for the root crate's TIFF reader/writer (kernels never do I/O).
-
 pub type Result<T> = std::result::Result<T, ImagingError>;

@@ -357,6 +357,266 @@ pub fn bgk_block<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
     m
 }
 
+/// The collision seam: collide a block of `W` nodes (populations `f[i][w]`, pre-collision in,
+/// post-collision out) whose first node, in node order, is `node`. The kernels (`kernel`,
+/// `kernel_aa`) and the PSM lattice of `lbdem-coupling` are generic over it and monomorphised, so
+/// the operator is inlined into their loops. Implemented by the uniform operator
+/// [`CollideParams`] (BGK or TRT, one rate everywhere) and by [`LocalRates`] (the same operator
+/// with ω⁺ read per node: the seam of local-τ rheology such as Bingham, Leonardi et al. 2014
+/// Eqs. 5-8). A new operator is a new type implementing this trait.
+pub trait Collider<L: Lattice, T: Real>: Copy + Send + Sync {
+    /// Collide `W` nodes starting at node `node`; the moments the collision used.
+    fn collide<const W: usize, const FORCED: bool>(
+        &self,
+        f: &mut [[T; W]; QMAX],
+        node: usize,
+    ) -> Moments<T, W>;
+}
+
+impl<L: Lattice, T: Real> Collider<L, T> for CollideParams<T> {
+    /// The uniform operator: `collide_block` (the node index is not read).
+    #[inline(always)]
+    fn collide<const W: usize, const FORCED: bool>(
+        &self,
+        f: &mut [[T; W]; QMAX],
+        _node: usize,
+    ) -> Moments<T, W> {
+        collide_block::<L, T, W, FORCED>(f, self)
+    }
+}
+
+/// The rate constants of one node in the storage precision (what `CollideParams` holds for the
+/// whole lattice), rounded from f64 exactly as `CollideParams::new` rounds them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeRates<T> {
+    pub omega_p: T,
+    pub omega_m: T,
+    pub force_p: T,
+    pub force_m: T,
+    /// 1 − ω⁺ (BGK path).
+    pub keep: T,
+}
+
+/// Per-node rates from per-node relaxation times τ⁺ (node order), with the kind (BGK or TRT with
+/// its magic Λ) of `collision`: node x gets exactly the constants `CollideParams::new` would give
+/// for `collision` with τ = `tau[x]`, so equal τ everywhere reproduces the uniform run bit for bit.
+/// Also returns whether every node has ω⁺ = ω⁻ (the BGK path).
+pub fn local_rates<T: Real>(
+    collision: &Collision,
+    tau: &[f64],
+) -> Result<(Vec<NodeRates<T>>, bool), LbmError> {
+    let mut out = Vec::with_capacity(tau.len());
+    let mut bgk = true;
+    for (node, &t) in tau.iter().enumerate() {
+        let c = match *collision {
+            Collision::Bgk { .. } => Collision::Bgk { tau: t },
+            Collision::Trt { magic, .. } => Collision::Trt { tau: t, magic },
+        };
+        let (wp, wm) = c.rates().map_err(|e| match e {
+            LbmError::Tau { tau } => LbmError::LocalTau { node, tau },
+            other => other,
+        })?;
+        bgk &= wp == wm;
+        out.push(NodeRates {
+            omega_p: T::from_f64(wp),
+            omega_m: T::from_f64(wm),
+            force_p: T::from_f64(1.0 - 0.5 * wp),
+            force_m: T::from_f64(1.0 - 0.5 * wm),
+            keep: T::from_f64(1.0 - wp),
+        });
+    }
+    Ok((out, bgk))
+}
+
+/// The uniform operator with per-node rates (Leonardi et al. 2014 Eq. 8: τ from the local
+/// apparent viscosity): `base` gives the force and whether every node takes the BGK path,
+/// `rates[node]` the relaxation constants. The arithmetic is that of `collide_block` lane by lane.
+#[derive(Clone, Copy, Debug)]
+pub struct LocalRates<'a, T> {
+    pub base: CollideParams<T>,
+    /// One entry per node of the lattice (node order).
+    pub rates: &'a [NodeRates<T>],
+}
+
+impl<L: Lattice, T: Real> Collider<L, T> for LocalRates<'_, T> {
+    #[inline(always)]
+    fn collide<const W: usize, const FORCED: bool>(
+        &self,
+        f: &mut [[T; W]; QMAX],
+        node: usize,
+    ) -> Moments<T, W> {
+        let mut r = [NodeRates::default(); W];
+        r.copy_from_slice(&self.rates[node..node + W]);
+        if self.base.bgk {
+            bgk_block_local::<L, T, W, FORCED>(f, &self.base, &r)
+        } else {
+            trt_block_local::<L, T, W, FORCED>(f, &self.base, &r)
+        }
+    }
+}
+
+/// `collide_block`'s TRT form with the rates of each lane from `r` (force from `p`).
+#[inline(always)]
+fn trt_block_local<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
+    f: &mut [[T; W]; QMAX],
+    p: &CollideParams<T>,
+    r: &[NodeRates<T>; W],
+) -> Moments<T, W> {
+    let zero = T::default();
+    let half = T::from_f64(0.5);
+    let one = T::from_f64(1.0);
+    let three = T::from_f64(3.0);
+    let c45 = T::from_f64(4.5);
+    let c15 = T::from_f64(1.5);
+    let nine = T::from_f64(9.0);
+    let mut rho = [zero; W];
+    let mut j = [[zero; W]; 3];
+    for i in 0..L::Q {
+        let c = L::C[i];
+        for w in 0..W {
+            rho[w] += f[i][w];
+        }
+        for a in 0..L::D {
+            if c[a] != 0 {
+                let s = T::from_f64(c[a] as f64);
+                for w in 0..W {
+                    j[a][w] += s * f[i][w];
+                }
+            }
+        }
+    }
+    let mut u = [[zero; W]; 3];
+    let mut usq = [zero; W];
+    let mut uf = [zero; W];
+    for w in 0..W {
+        let inv = one / rho[w];
+        for a in 0..L::D {
+            u[a][w] = if FORCED {
+                (j[a][w] + half * p.force[a]) * inv
+            } else {
+                j[a][w] * inv
+            };
+            usq[w] += u[a][w] * u[a][w];
+            if FORCED {
+                uf[w] += u[a][w] * p.force[a];
+            }
+        }
+    }
+    {
+        let w0 = T::from_f64(L::W[0]);
+        for w in 0..W {
+            let feq = w0 * rho[w] * (one - c15 * usq[w]);
+            f[0][w] = f[0][w] - r[w].omega_p * (f[0][w] - feq);
+            if FORCED {
+                let s = -w0 * three * uf[w];
+                f[0][w] += r[w].force_p * s;
+            }
+        }
+    }
+    for &i in L::HALF {
+        let o = L::OPP[i];
+        let c = L::C[i];
+        let wi = T::from_f64(L::W[i]);
+        let mut cf = zero;
+        for a in 0..L::D {
+            cf += T::from_f64(c[a] as f64) * p.force[a];
+        }
+        let (cx, cy, cz) = (
+            T::from_f64(c[0] as f64),
+            T::from_f64(c[1] as f64),
+            T::from_f64(c[2] as f64),
+        );
+        for w in 0..W {
+            let mut cu = cx * u[0][w] + cy * u[1][w];
+            if L::D == 3 {
+                cu += cz * u[2][w];
+            }
+            let wr = wi * rho[w];
+            let feq_s = wr * (one + c45 * cu * cu - c15 * usq[w]);
+            let feq_a = wr * three * cu;
+            let fs = half * (f[i][w] + f[o][w]);
+            let fa = half * (f[i][w] - f[o][w]);
+            let mut ns = fs - r[w].omega_p * (fs - feq_s);
+            let mut na = fa - r[w].omega_m * (fa - feq_a);
+            if FORCED {
+                let s_s = wi * (nine * cu * cf - three * uf[w]);
+                let s_a = wi * three * cf;
+                ns += r[w].force_p * s_s;
+                na += r[w].force_m * s_a;
+            }
+            f[i][w] = ns + na;
+            f[o][w] = ns - na;
+        }
+    }
+    Moments { rho, u, usq }
+}
+
+/// `bgk_block` with the rates of each lane from `r` (the products that `bgk_block` hoists out of
+/// the lane loop are formed per lane in the same order, so equal rates give the same bits).
+#[inline(always)]
+fn bgk_block_local<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
+    f: &mut [[T; W]; QMAX],
+    p: &CollideParams<T>,
+    r: &[NodeRates<T>; W],
+) -> Moments<T, W> {
+    let m = moments::<L, T, W, FORCED>(f, p);
+    let one = T::from_f64(1.0);
+    let three = T::from_f64(3.0);
+    let c45 = T::from_f64(4.5);
+    let m15 = T::from_f64(-1.5);
+    let nine = T::from_f64(9.0);
+    let mut base = [T::default(); W];
+    let mut uf = [T::default(); W];
+    for w in 0..W {
+        base[w] = m15.mul_add(m.usq[w], one);
+        if FORCED {
+            for a in 0..L::D {
+                uf[w] = m.u[a][w].mul_add(p.force[a], uf[w]);
+            }
+        }
+    }
+    {
+        let w0 = T::from_f64(L::W[0]);
+        for w in 0..W {
+            let ow0 = r[w].omega_p * w0;
+            let src0 = r[w].force_p * (-(w0 * three));
+            let mut a = (ow0 * m.rho[w]) * base[w];
+            if FORCED {
+                a = src0.mul_add(uf[w], a);
+            }
+            f[0][w] = r[w].keep.mul_add(f[0][w], a);
+        }
+    }
+    unroll!(h in [0, 1, 2, 3, 4, 5, 6, 7, 8] {
+        if h < L::HALF.len() {
+        let i = L::HALF[h];
+        let o = L::OPP[i];
+        let c = L::C[i];
+        let wi = T::from_f64(L::W[i]);
+        let cf = c_dot(c, p.force);
+        for w in 0..W {
+            let owi = r[w].omega_p * wi;
+            let owi3 = owi * three;
+            let s9 = r[w].force_p * wi * nine * cf;
+            let s3 = r[w].force_p * wi * three;
+            let s_odd = s3 * cf;
+            let cu = c_dot(c, [m.u[0][w], m.u[1][w], m.u[2][w]]);
+            let rho = m.rho[w];
+            let mut a = (owi * rho) * (c45 * cu).mul_add(cu, base[w]);
+            let mut b = (owi3 * rho) * cu;
+            if FORCED {
+                a = s9.mul_add(cu, a);
+                a = (-s3).mul_add(uf[w], a);
+                b += s_odd;
+            }
+            f[i][w] = r[w].keep.mul_add(f[i][w], a + b);
+            f[o][w] = r[w].keep.mul_add(f[o][w], a - b);
+        }
+        }
+    });
+    m
+}
+
 /// Equilibrium populations (Su Eq. 7) for one node.
 pub fn equilibrium<L: Lattice>(rho: f64, u: [f64; 3]) -> [f64; QMAX] {
     let mut out = [0.0; QMAX];

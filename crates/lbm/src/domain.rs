@@ -37,7 +37,7 @@ impl Face {
 
 /// Box of `n[0] x n[1] x n[2]` nodes (n[2] = 1 in 2D), index = x + nx (y + ny z).
 /// `faces` = [x-, x+, y-, y+, z-, z+].
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Domain {
     pub n: [usize; 3],
     pub faces: [Face; 6],

@@ -1,11 +1,11 @@
 //! The fused stream-collide kernel over structure-of-arrays storage (two arrays, pull scheme):
 //! each fluid node gathers f_i from x − c_i (Su Eq. 12 read backwards), applies halfway
 //! bounce-back with the moving-wall term (Leonardi Eq. 19) or Zou-He where the upstream node is a
-//! wall or outside the box, collides (`collision::collide_block`) and writes its own slot of the
+//! wall or outside the box, collides (a `collision::Collider`, monomorphised) and writes its own slot of the
 //! destination. Rows are independent, so the result does not depend on how rows are spread over
 //! threads. Interior runs take a branch-free path in blocks of `W` nodes that auto-vectorises.
 
-use crate::collision::{CollideParams, Moments, collide_block};
+use crate::collision::{Collider, Moments};
 use crate::domain::{Domain, FLUID, Face, Motion};
 use crate::lattice::{Lattice, QMAX};
 use crate::plan::{Plan, Upstream, neighbour};
@@ -42,7 +42,7 @@ pub fn wrap(v: usize, d: i32, n: usize) -> usize {
 }
 
 /// Accepted range of the macroscopic fields; outside it the run is stopped (see `Stepper`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Limits {
     pub rho_min: f64,
     pub rho_max: f64,
@@ -51,17 +51,26 @@ pub struct Limits {
 
 impl Default for Limits {
     /// |u| < 0.4 (Ma ≈ 0.69): far beyond any accurate run (Su Eq. 16 asks Ma < 0.1); density
-    /// within a factor 2 of the reference 1.
+    /// within a factor 2 of the reference 1 (the constants of `lbdem_core::units::lattice`).
     fn default() -> Self {
+        use lbdem_core::units::lattice::{RHO_MAX, RHO_MIN, U_MAX};
         Self {
-            rho_min: 0.5,
-            rho_max: 2.0,
-            u_max: 0.4,
+            rho_min: RHO_MIN,
+            rho_max: RHO_MAX,
+            u_max: U_MAX,
         }
     }
 }
 
 impl Limits {
+    /// True when a node of density `rho` and velocity `u` (f64) is within the limits and finite:
+    /// the check of every code path that works in f64 (diagnosis, PSM lattice).
+    #[inline]
+    pub fn accepts(&self, rho: f64, u: [f64; 3]) -> bool {
+        let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+        rho.is_finite() && speed.is_finite() && rho > self.rho_min && rho < self.rho_max && speed < self.u_max
+    }
+
     /// The limits in the storage precision: the per-node check is then three vector compares on
     /// ρ and |u|² as the collision computed them (a NaN fails every compare, so it is caught).
     pub fn in_precision<T: Real>(&self) -> LimitsT<T> {
@@ -103,12 +112,13 @@ pub struct MacroOut {
 }
 
 /// Everything a row needs, borrowed for one step.
-pub struct Ctx<'a, T> {
+pub struct Ctx<'a, T, C> {
     pub dom: &'a Domain,
     pub plan: &'a Plan,
     pub src: &'a [T],
     pub dst: SyncPtr<T>,
-    pub params: CollideParams<T>,
+    /// The collision operator (uniform `CollideParams` or per-node `LocalRates`).
+    pub coll: C,
     /// Motion of each obstacle, then of the six faces (velocity only).
     pub motions: &'a [Motion],
     pub limits: LimitsT<T>,
@@ -120,7 +130,7 @@ pub struct Ctx<'a, T> {
 /// # Safety
 /// `ctx.dst` (and `ctx.out`) must point to arrays of the right length, and no other thread may
 /// write row `r` during the call.
-pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) -> bool {
+pub unsafe fn row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(ctx: &Ctx<T, C>, r: usize) -> bool {
     let dom = ctx.dom;
     let [nx, ny, _] = dom.n;
     let n = dom.len();
@@ -146,9 +156,9 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
         good &= unsafe {
             if wide::<T>() == 32 {
-                span::<L, T, F, 32>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
+                span::<L, T, C, F, 32>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
             } else {
-                span::<L, T, F, 16>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
+                span::<L, T, C, F, 16>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
             }
         };
     }
@@ -159,15 +169,15 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
         for i in 0..L::Q {
             f[i][0] = ctx.src[up_off[i] + wrap(x, -L::C[i][0], nx)];
         }
-        let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+        let m = C::collide::<1, F>(&ctx.coll, &mut f, row_off + x);
         for i in 0..L::Q {
             // SAFETY: row r is ours.
             unsafe { *ctx.dst.0.add(i * n + row_off + x) = f[i][0] };
         }
-        good &= finish_block::<T, 1>(ctx, &m, row_off + x);
+        good &= finish_block::<T, C, 1>(ctx, &m, row_off + x);
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
-        good &= unsafe { general_node::<L, T, F>(ctx, [x as usize, y, z]) };
+        good &= unsafe { general_node::<L, T, C, F>(ctx, [x as usize, y, z]) };
     }
     good
 }
@@ -178,8 +188,8 @@ pub unsafe fn row<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, r: usize) ->
 /// # Safety
 /// As `block`.
 #[inline(always)]
-unsafe fn span<L: Lattice, T: Real, const F: bool, const WB: usize>(
-    ctx: &Ctx<T>,
+unsafe fn span<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB: usize>(
+    ctx: &Ctx<T, C>,
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
     x0: usize,
@@ -191,14 +201,14 @@ unsafe fn span<L: Lattice, T: Real, const F: bool, const WB: usize>(
     let mut f = [[T::default(); WB]; QMAX];
     let mut x = x0;
     while x + WB <= x1 {
-        good &= unsafe { block::<L, T, WB, F>(ctx, &mut f, src, dst, x, row_off + x) };
+        good &= unsafe { block::<L, T, C, WB, F>(ctx, &mut f, src, dst, x, row_off + x) };
         x += WB;
     }
     macro_rules! tail {
         ($b:literal) => {
             if $b < WB && $b <= x1 - x {
                 let mut g = [[T::default(); $b]; QMAX];
-                good &= unsafe { block::<L, T, $b, F>(ctx, &mut g, src, dst, x, row_off + x) };
+                good &= unsafe { block::<L, T, C, $b, F>(ctx, &mut g, src, dst, x, row_off + x) };
                 x += $b;
             }
         };
@@ -218,8 +228,8 @@ unsafe fn span<L: Lattice, T: Real, const F: bool, const WB: usize>(
 /// # Safety
 /// `src[i] + x + B <= Q n` (fast spans only) and the destination nodes belong to the calling row.
 #[inline(always)]
-unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
-    ctx: &Ctx<T>,
+unsafe fn block<L: Lattice, T: Real, C: Collider<L, T>, const B: usize, const F: bool>(
+    ctx: &Ctx<T, C>,
     f: &mut [[T; B]; QMAX],
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
@@ -230,16 +240,16 @@ unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
         let s = src[i].wrapping_add(x);
         f[i].copy_from_slice(&ctx.src[s..s + B]);
     }
-    let m = collide_block::<L, T, B, F>(f, &ctx.params);
+    let m = C::collide::<B, F>(&ctx.coll, f, node);
     for i in 0..L::Q {
         // SAFETY: caller's contract.
         unsafe { std::ptr::copy_nonoverlapping(f[i].as_ptr(), ctx.dst.0.add(dst[i] + x), B) };
     }
-    finish_block::<T, B>(ctx, &m, node)
+    finish_block::<T, C, B>(ctx, &m, node)
 }
 
 #[inline(always)]
-fn finish_block<T: Real, const B: usize>(ctx: &Ctx<T>, m: &Moments<T, B>, idx0: usize) -> bool {
+fn finish_block<T: Real, C, const B: usize>(ctx: &Ctx<T, C>, m: &Moments<T, B>, idx0: usize) -> bool {
     let good = ctx.limits.bad_lanes(&m.rho, &m.usq) == 0;
     if let Some(o) = ctx.out {
         for w in 0..B {
@@ -257,7 +267,10 @@ fn finish_block<T: Real, const B: usize>(ctx: &Ctx<T>, m: &Moments<T, B>, idx0: 
 }
 
 /// One node next to a wall, an obstacle, a non-periodic face or a periodic x edge.
-unsafe fn general_node<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, p: [usize; 3]) -> bool {
+unsafe fn general_node<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+    ctx: &Ctx<T, C>,
+    p: [usize; 3],
+) -> bool {
     let dom = ctx.dom;
     let n = dom.len();
     let idx = dom.index(p[0], p[1], p[2]);
@@ -315,9 +328,9 @@ unsafe fn general_node<L: Lattice, T: Real, const F: bool>(ctx: &Ctx<T>, p: [usi
             }
         }
     }
-    let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+    let m = C::collide::<1, F>(&ctx.coll, &mut f, idx);
     for i in 0..L::Q {
         unsafe { *ctx.dst.0.add(i * n + idx) = f[i][0] };
     }
-    finish_block::<T, 1>(ctx, &m, idx)
+    finish_block::<T, C, 1>(ctx, &m, idx)
 }

@@ -12,7 +12,7 @@
 //! nodes are independent and rows can run on any thread. The bounce-back arithmetic is written
 //! exactly as in the two-array kernel, so both give bitwise-identical results.
 
-use crate::collision::{CollideParams, Moments, collide_block};
+use crate::collision::{Collider, Moments};
 use crate::domain::{Domain, FLUID, Motion};
 use crate::kernel::{LimitsT, MacroOut, SyncPtr, wide, wrap};
 use crate::lattice::{Lattice, QMAX};
@@ -23,13 +23,14 @@ use crate::real::Real;
 /// First node of a row that left the limits: (x, ρ, u).
 pub type Bad = Option<(usize, f64, [f64; 3])>;
 
-pub struct CtxAa<'a, T> {
+pub struct CtxAa<'a, T, C> {
     pub dom: &'a Domain,
     pub plan: &'a Plan,
     /// The single population array (read and written through raw pointers only), in `layout`.
     pub f: SyncPtr<T>,
     pub layout: Layout,
-    pub params: CollideParams<T>,
+    /// The collision operator (uniform `CollideParams` or per-node `LocalRates`).
+    pub coll: C,
     pub motions: &'a [Motion],
     pub limits: LimitsT<T>,
     pub out: Option<MacroOut>,
@@ -37,10 +38,10 @@ pub struct CtxAa<'a, T> {
 
 /// Range check of a block of `B` nodes starting at node `idx0` (and the macroscopic output).
 #[inline(always)]
-fn check<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize, bad: &mut Bad) {
+fn check<T: Real, C, const B: usize>(ctx: &CtxAa<T, C>, m: &Moments<T, B>, idx0: usize, bad: &mut Bad) {
     let bits = ctx.limits.bad_lanes(&m.rho, &m.usq);
-    if bits != 0 && bad.is_none() {
-        *bad = first_bad(ctx, m, idx0, bits);
+    if bits != 0 {
+        keep_lowest_x(bad, first_bad(ctx, m, idx0, bits));
     }
     if let Some(o) = ctx.out {
         for w in 0..B {
@@ -56,10 +57,27 @@ fn check<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize
     }
 }
 
+/// Keep the flagged node of lowest x of the row (rows are processed spans first, then periodic
+/// edges, then general nodes): the node the two-array stepper's row scan reports.
+#[cold]
+#[inline(never)]
+fn keep_lowest_x(bad: &mut Bad, cand: Bad) {
+    if let Some(c) = cand
+        && bad.is_none_or(|b| c.0 < b.0)
+    {
+        *bad = Some(c);
+    }
+}
+
 /// The first node of a block flagged in `bits`, for the diagnosis (rare: kept out of line).
 #[cold]
 #[inline(never)]
-fn first_bad<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: usize, bits: u32) -> Bad {
+fn first_bad<T: Real, C, const B: usize>(
+    ctx: &CtxAa<T, C>,
+    m: &Moments<T, B>,
+    idx0: usize,
+    bits: u32,
+) -> Bad {
     let w = bits.trailing_zeros() as usize;
     let u = [m.u[0][w].to_f64(), m.u[1][w].to_f64(), m.u[2][w].to_f64()];
     Some(((idx0 + w) % ctx.dom.n[0], m.rho[w].to_f64(), u))
@@ -69,7 +87,10 @@ fn first_bad<T: Real, const B: usize>(ctx: &CtxAa<T>, m: &Moments<T, B>, idx0: u
 ///
 /// # Safety
 /// `ctx.f` must hold Q `ctx.layout.stride` values; no other thread may touch the nodes of row `r`.
-pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
+pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+    ctx: &CtxAa<T, C>,
+    r: usize,
+) -> Bad {
     let dom = ctx.dom;
     let nx = dom.n[0];
     let n = ctx.layout.stride;
@@ -86,7 +107,7 @@ pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: us
         dst[i] = L::OPP[i] * n + slot_off;
     }
     for &(x0, x1) in &plan.runs[plan.run_start[r] as usize..plan.run_start[r + 1] as usize] {
-        unsafe { run::<L, T, F>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
+        unsafe { run::<L, T, C, F>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     bad
 }
@@ -96,8 +117,8 @@ pub unsafe fn even_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: us
 /// # Safety
 /// The slots must be in bounds and belong to nodes of the calling row (module doc).
 #[inline(always)]
-unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
-    ctx: &CtxAa<T>,
+unsafe fn block<L: Lattice, T: Real, C: Collider<L, T>, const B: usize, const F: bool>(
+    ctx: &CtxAa<T, C>,
     f: &mut [[T; B]; QMAX],
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
@@ -108,11 +129,11 @@ unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
     for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
         unsafe { std::ptr::copy_nonoverlapping(ctx.f.0.add(src[i].wrapping_add(x)), fi.as_mut_ptr(), B) };
     }
-    let m = collide_block::<L, T, B, F>(f, &ctx.params);
+    let m = C::collide::<B, F>(&ctx.coll, f, node);
     for (i, fi) in f.iter().enumerate().take(L::Q) {
         unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(dst[i].wrapping_add(x)), B) };
     }
-    check::<T, B>(ctx, &m, node, bad);
+    check::<T, C, B>(ctx, &m, node, bad);
 }
 
 /// Nodes [x0, x1) of a row in blocks of `kernel::wide::<T>()` nodes (two AVX-512 registers per
@@ -122,8 +143,8 @@ unsafe fn block<L: Lattice, T: Real, const B: usize, const F: bool>(
 /// # Safety
 /// As `block`.
 #[inline(always)]
-unsafe fn run<L: Lattice, T: Real, const F: bool>(
-    ctx: &CtxAa<T>,
+unsafe fn run<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+    ctx: &CtxAa<T, C>,
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
     x0: usize,
@@ -132,15 +153,15 @@ unsafe fn run<L: Lattice, T: Real, const F: bool>(
     bad: &mut Bad,
 ) {
     if wide::<T>() == 32 {
-        unsafe { run_w::<L, T, F, 32>(ctx, src, dst, x0, x1, node_off, bad) }
+        unsafe { run_w::<L, T, C, F, 32>(ctx, src, dst, x0, x1, node_off, bad) }
     } else {
-        unsafe { run_w::<L, T, F, 16>(ctx, src, dst, x0, x1, node_off, bad) }
+        unsafe { run_w::<L, T, C, F, 16>(ctx, src, dst, x0, x1, node_off, bad) }
     }
 }
 
 #[inline(always)]
-unsafe fn run_w<L: Lattice, T: Real, const F: bool, const WB: usize>(
-    ctx: &CtxAa<T>,
+unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB: usize>(
+    ctx: &CtxAa<T, C>,
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
     x0: usize,
@@ -152,14 +173,14 @@ unsafe fn run_w<L: Lattice, T: Real, const F: bool, const WB: usize>(
     let mut f = [[T::default(); WB]; QMAX];
     let mut x = x0;
     while x + WB <= x1 {
-        unsafe { block::<L, T, WB, F>(ctx, &mut f, src, dst, x, node_off + x, bad) };
+        unsafe { block::<L, T, C, WB, F>(ctx, &mut f, src, dst, x, node_off + x, bad) };
         x += WB;
     }
     macro_rules! tail {
         ($b:literal) => {
             if $b < WB && $b <= x1 - x {
                 let mut g = [[T::default(); $b]; QMAX];
-                unsafe { block::<L, T, $b, F>(ctx, &mut g, src, dst, x, node_off + x, bad) };
+                unsafe { block::<L, T, C, $b, F>(ctx, &mut g, src, dst, x, node_off + x, bad) };
                 x += $b;
             }
         };
@@ -177,7 +198,10 @@ unsafe fn run_w<L: Lattice, T: Real, const F: bool, const WB: usize>(
 /// # Safety
 /// As `even_row`; the slots a node touches are its own (see the module doc), so rows may run
 /// concurrently.
-pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usize) -> Bad {
+pub unsafe fn odd_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+    ctx: &CtxAa<T, C>,
+    r: usize,
+) -> Bad {
     let dom = ctx.dom;
     let [nx, ny, nz] = dom.n;
     let n = ctx.layout.stride;
@@ -201,7 +225,7 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
     }
     let plan = ctx.plan;
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
-        unsafe { run::<L, T, F>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
+        unsafe { run::<L, T, C, F>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     for &x in &plan.wraps[plan.wrap_start[r] as usize..plan.wrap_start[r + 1] as usize] {
         let x = x as usize;
@@ -209,20 +233,26 @@ pub unsafe fn odd_row<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, r: usi
         for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
             fi[0] = unsafe { *ctx.f.0.add(up_row[i] + wrap(x, -L::C[i][0], nx)) };
         }
-        let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+        let m = C::collide::<1, F>(&ctx.coll, &mut f, row_off + x);
         for (i, fi) in f.iter().enumerate().take(L::Q) {
             unsafe { *ctx.f.0.add(down_row[i] + wrap(x, L::C[i][0], nx)) = fi[0] };
         }
-        check::<T, 1>(ctx, &m, row_off + x, &mut bad);
+        check::<T, C, 1>(ctx, &m, row_off + x, &mut bad);
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
-        unsafe { odd_general::<L, T, F>(ctx, [x as usize, y, z], &mut bad) };
+        unsafe { odd_general::<L, T, C, F>(ctx, [x as usize, y, z], &mut bad) };
     }
     bad
 }
 
 /// Wall velocity at the link midpoint p + s c/2 towards a solid node `s_idx` (obstacle or inactive).
-fn wall_velocity(ctx: &CtxAa<impl Real>, p: [usize; 3], c: [i32; 3], sign: f64, s_idx: usize) -> [f64; 3] {
+fn wall_velocity<C>(
+    ctx: &CtxAa<impl Real, C>,
+    p: [usize; 3],
+    c: [i32; 3],
+    sign: f64,
+    s_idx: usize,
+) -> [f64; 3] {
     let dom = ctx.dom;
     let id = dom.obstacle[s_idx] as usize;
     if id < ctx.motions.len() - 6 {
@@ -234,7 +264,11 @@ fn wall_velocity(ctx: &CtxAa<impl Real>, p: [usize; 3], c: [i32; 3], sign: f64, 
     }
 }
 
-unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [usize; 3], bad: &mut Bad) {
+unsafe fn odd_general<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+    ctx: &CtxAa<T, C>,
+    p: [usize; 3],
+    bad: &mut Bad,
+) {
     let dom = ctx.dom;
     let lay = &ctx.layout;
     let idx = dom.index(p[0], p[1], p[2]);
@@ -259,7 +293,7 @@ unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [us
             },
         };
     }
-    let m = collide_block::<L, T, 1, F>(&mut f, &ctx.params);
+    let m = C::collide::<1, F>(&ctx.coll, &mut f, idx);
     for (i, fi) in f.iter().enumerate().take(L::Q) {
         let c = L::C[i];
         let o = L::OPP[i];
@@ -274,5 +308,5 @@ unsafe fn odd_general<L: Lattice, T: Real, const F: bool>(ctx: &CtxAa<T>, p: [us
             },
         }
     }
-    check::<T, 1>(ctx, &m, idx, bad);
+    check::<T, C, 1>(ctx, &m, idx, bad);
 }

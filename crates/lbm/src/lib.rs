@@ -12,6 +12,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod collision;
+pub mod diagnosis;
 pub mod domain;
 pub mod kernel;
 pub mod kernel_aa;
@@ -24,7 +25,8 @@ pub mod stepper;
 pub mod stepper_aa;
 pub mod zouhe;
 
-pub use collision::Collision;
+pub use collision::{Collider, Collision, LocalRates, NodeRates};
+pub use diagnosis::BadNode;
 pub use domain::{Domain, Face, Motion};
 pub use kernel::Limits;
 pub use lattice::{D2Q9, D3Q19, Lattice};
@@ -40,6 +42,17 @@ pub enum LbmError {
          increase the viscosity or the time step, or refine dx"
     )]
     Tau { tau: f64 },
+    #[error(
+        "local relaxation time tau = {tau} at node {node} must be > 0.5 and finite (Su et al. 2020 \
+         Eq. 15); clamp the local viscosity (e.g. the Bingham cap) so that tau stays above 0.5, and \
+         give solid or inactive nodes any valid tau"
+    )]
+    LocalTau { node: usize, tau: f64 },
+    #[error(
+        "per-node relaxation times: {got} values for a lattice of {nodes} nodes; give one tau per node \
+         in node order (x + nx (y + ny z))"
+    )]
+    LocalTauLength { got: usize, nodes: usize },
     #[error("TRT magic parameter = {magic} must be > 0; use 0.25 (stability) or 3/16 (exact walls)")]
     Magic { magic: f64 },
     #[error("unsupported set-up: {0}")]

@@ -16,6 +16,8 @@ pub trait Real:
     + Div<Output = Self>
     + Neg<Output = Self>
     + AddAssign
+    + serde::Serialize
+    + serde::de::DeserializeOwned
     + 'static
 {
     const NAME: &'static str;

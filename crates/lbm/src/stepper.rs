@@ -4,7 +4,8 @@
 //! fused stream-collide on a caller-chosen rayon pool, and the instability check.
 
 use crate::LbmError;
-use crate::collision::{CollideParams, Collision, equilibrium};
+use crate::collision::{CollideParams, Collider, Collision, LocalRates, NodeRates, equilibrium, local_rates};
+use crate::diagnosis::BadNode;
 use crate::domain::{Domain, FLUID, Face, Motion};
 use crate::kernel::{self, Ctx, Limits, MacroOut, SyncPtr};
 use crate::lattice::{Lattice, QMAX};
@@ -20,8 +21,11 @@ pub struct ForceTorque {
     pub torque: [f64; 3],
 }
 
-/// Lattice state: plain data the coupling code may read and modify between steps.
-#[derive(Clone, Debug)]
+/// Lattice state: plain data the coupling code may read and modify between steps. It is all a
+/// step reads besides the settings (and per-node τ, if any), so serialising it (serde) and
+/// stepping the restored copy continues the run bit for bit.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
 pub struct Fluid<L: Lattice, T: Real> {
     pub domain: Domain,
     /// Post-collision populations of the current time, `f[i * n + node]`.
@@ -30,6 +34,7 @@ pub struct Fluid<L: Lattice, T: Real> {
     pub obstacles: Vec<Motion>,
     /// Completed steps.
     pub step: u64,
+    #[serde(skip)]
     _l: PhantomData<L>,
 }
 
@@ -80,7 +85,7 @@ impl<L: Lattice, T: Real> Fluid<L, T> {
 }
 
 /// Macroscopic fields of the last step (written by the kernel when asked).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Macro {
     pub rho: Vec<f64>,
     /// Interleaved xyz.
@@ -88,7 +93,7 @@ pub struct Macro {
 }
 
 /// Settings of a run that do not change from step to step.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Settings {
     pub collision: Collision,
     /// Uniform body-force density on fluid nodes (lattice units).
@@ -100,6 +105,8 @@ pub struct Settings {
 pub struct Stepper<L: Lattice, T: Real> {
     settings: Settings,
     params: CollideParams<T>,
+    /// Per-node rates (`set_local_tau`) and the τ they came from (diagnosis).
+    local: Option<(Vec<NodeRates<T>>, Vec<f64>)>,
     plan: Plan,
     other: Vec<T>,
     row_good: Vec<bool>,
@@ -111,6 +118,44 @@ pub struct Stepper<L: Lattice, T: Real> {
 
 /// Rows per rayon task: fixed, so work splitting is the same for every pool size.
 const ROWS_PER_TASK: usize = 4;
+
+/// Every row of one two-array step on the current rayon pool, with the collision `C`.
+fn run_rows<L: Lattice, T: Real, C: Collider<L, T>>(row_good: &mut [bool], ctx: &Ctx<T, C>, forced: bool) {
+    row_good
+        .par_chunks_mut(ROWS_PER_TASK)
+        .enumerate()
+        .for_each(|(c, flags)| {
+            for (k, g) in flags.iter_mut().enumerate() {
+                let r = c * ROWS_PER_TASK + k;
+                // SAFETY: each row index belongs to exactly one chunk.
+                *g = unsafe {
+                    if forced {
+                        kernel::row::<L, T, C, true>(ctx, r)
+                    } else {
+                        kernel::row::<L, T, C, false>(ctx, r)
+                    }
+                };
+            }
+        });
+}
+
+/// Per-node rates from `tau` (shared by both steppers); sets `params.bgk` for the block path.
+pub(crate) fn make_local<T: Real>(
+    collision: &Collision,
+    params: &mut CollideParams<T>,
+    tau: Vec<f64>,
+    nodes: usize,
+) -> Result<(Vec<NodeRates<T>>, Vec<f64>), LbmError> {
+    if tau.len() != nodes {
+        return Err(LbmError::LocalTauLength {
+            got: tau.len(),
+            nodes,
+        });
+    }
+    let (rates, bgk) = local_rates::<T>(collision, &tau)?;
+    params.bgk = bgk;
+    Ok((rates, tau))
+}
 
 impl<L: Lattice, T: Real> Stepper<L, T> {
     /// Check the settings against the domain and build the row plan.
@@ -156,6 +201,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
         let mut s = Self {
             settings,
             params,
+            local: None,
             plan: Plan::default(),
             other: vec![T::default(); fluid.f.len()],
             row_good: vec![true; dom.n[1] * dom.n[2]],
@@ -176,6 +222,38 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
     pub fn settings(&self) -> &Settings {
         &self.settings
     }
+
+    /// Relax node x with τ⁺ = `tau[x]` (node order) instead of the settings' τ, keeping the kind
+    /// of collision (BGK, or TRT with its magic Λ): the seam of local-τ rheology (Bingham,
+    /// Leonardi et al. 2014 Eq. 8). May be called between any two steps; equal values everywhere
+    /// give the uniform run bit for bit. Refuses a τ ≤ ½ or a length other than the node count.
+    pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), LbmError> {
+        let nodes = self.other.len() / L::Q;
+        self.local = Some(make_local::<T>(
+            &self.settings.collision,
+            &mut self.params,
+            tau,
+            nodes,
+        )?);
+        Ok(())
+    }
+
+    /// Back to the settings' uniform τ.
+    pub fn clear_local_tau(&mut self) {
+        self.local = None;
+        self.params.bgk = self
+            .settings
+            .collision
+            .rates()
+            .map(|(p, m)| p == m)
+            .unwrap_or(true);
+    }
+
+    /// The per-node τ in use, if any.
+    pub fn local_tau(&self) -> Option<&[f64]> {
+        self.local.as_ref().map(|(_, t)| t.as_slice())
+    }
+
     pub fn plan(&self) -> &Plan {
         &self.plan
     }
@@ -205,33 +283,41 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
                 u: SyncPtr(m.u.as_mut_ptr()),
             }
         });
-        let ctx = Ctx {
-            dom: &fluid.domain,
-            plan: &self.plan,
-            src: &fluid.f,
-            dst: SyncPtr(self.other.as_mut_ptr()),
-            params: self.params,
-            motions: &self.motions,
-            limits: self.settings.limits.in_precision::<T>(),
-            out,
-        };
+        let limits = self.settings.limits.in_precision::<T>();
         let forced = self.settings.force.iter().any(|&x| x != 0.0);
-        self.row_good
-            .par_chunks_mut(ROWS_PER_TASK)
-            .enumerate()
-            .for_each(|(c, flags)| {
-                for (k, g) in flags.iter_mut().enumerate() {
-                    let r = c * ROWS_PER_TASK + k;
-                    // SAFETY: each row index belongs to exactly one chunk.
-                    *g = unsafe {
-                        if forced {
-                            kernel::row::<L, T, true>(&ctx, r)
-                        } else {
-                            kernel::row::<L, T, false>(&ctx, r)
-                        }
-                    };
-                }
-            });
+        let dst = SyncPtr(self.other.as_mut_ptr());
+        let (dom, plan, motions) = (&fluid.domain, &self.plan, &self.motions);
+        match &self.local {
+            None => {
+                let ctx = Ctx {
+                    dom,
+                    plan,
+                    src: &fluid.f,
+                    dst,
+                    coll: self.params,
+                    motions,
+                    limits,
+                    out,
+                };
+                run_rows::<L, T, _>(&mut self.row_good, &ctx, forced);
+            }
+            Some((rates, _)) => {
+                let ctx = Ctx {
+                    dom,
+                    plan,
+                    src: &fluid.f,
+                    dst,
+                    coll: LocalRates {
+                        base: self.params,
+                        rates,
+                    },
+                    motions,
+                    limits,
+                    out,
+                };
+                run_rows::<L, T, _>(&mut self.row_good, &ctx, forced);
+            }
+        }
         std::mem::swap(&mut fluid.f, &mut self.other);
         fluid.step += 1;
         if let Some(r) = self.row_good.iter().position(|g| !g) {
@@ -281,13 +367,12 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
         }
     }
 
-    /// Find the first bad node of row `r` and name the likely cause.
+    /// Find the first bad node of row `r` and name the likely cause (`diagnosis`).
     fn diagnose(&self, fluid: &Fluid<L, T>, r: usize) -> LbmError {
         let dom = &fluid.domain;
         let [nx, ny, _] = dom.n;
         let (y, z) = (r % ny, r / ny);
         let lim = self.settings.limits;
-        let tau = self.settings.collision.tau();
         for x in 0..nx {
             let idx = dom.index(x, y, z);
             if dom.kind[idx] != FLUID {
@@ -297,19 +382,21 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             // ρ is unchanged by collision, u = (Σ f c − F/2)/ρ undoes the Guo half-force.
             let (rho, j) = fluid.moments(idx);
             let u = [0, 1, 2].map(|a| (j[a] - 0.5 * self.settings.force[a]) / rho);
-            let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-            let finite = rho.is_finite() && speed.is_finite();
-            if finite && rho > lim.rho_min && rho < lim.rho_max && speed < lim.u_max {
+            if lim.accepts(rho, u) {
                 continue;
             }
-            let cause = likely_cause(tau, rho, u, &lim);
-            return LbmError::Unstable {
+            let tau = match &self.local {
+                Some((_, t)) => t[idx],
+                None => self.settings.collision.tau(),
+            };
+            return BadNode {
                 step: fluid.step,
                 node: [x, y, z],
                 rho,
                 u,
-                cause,
-            };
+                tau,
+            }
+            .into_error(&lim);
         }
         LbmError::Unstable {
             step: fluid.step,
@@ -318,36 +405,6 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             u: [f64::NAN; 3],
             cause: "row flagged but no bad node found (internal)".into(),
         }
-    }
-}
-
-/// The likely cause of a node leaving the limits, with the fix.
-pub(crate) fn likely_cause(tau: f64, rho: f64, u: [f64; 3], lim: &Limits) -> String {
-    let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-    let finite = rho.is_finite() && speed.is_finite();
-    let mach = speed / (1.0f64 / 3.0).sqrt();
-    if !finite && tau < 0.55 {
-        format!(
-            "relaxation time tau = {tau:.4} is close to 0.5 (under-resolved viscosity); raise tau \
-             (larger viscosity or time step relative to dx^2) or use TRT"
-        )
-    } else if speed >= lim.u_max || (!finite && mach > 0.3) {
-        format!(
-            "local Mach number |u|/c_s = {mach:.3} beyond the limit {:.3}: lower the velocity in \
-             lattice units (smaller time step or coarser dx)",
-            lim.u_max / (1.0f64 / 3.0).sqrt()
-        )
-    } else if finite {
-        format!(
-            "density {rho:.4} outside [{}, {}]: compressibility error from a too large pressure \
-             drop or velocity; lower the driving (force, pressure, velocity) in lattice units",
-            lim.rho_min, lim.rho_max
-        )
-    } else {
-        format!(
-            "non-finite value with tau = {tau:.4}: the run went unstable (most often tau near 0.5 \
-             or Mach too high); raise tau, refine the lattice or lower the velocity"
-        )
     }
 }
 

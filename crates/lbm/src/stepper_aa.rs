@@ -5,7 +5,8 @@
 //! here (use `Stepper`). Forces are refreshed every step from whichever layout the array is in.
 
 use crate::LbmError;
-use crate::collision::CollideParams;
+use crate::collision::{CollideParams, LocalRates, NodeRates};
+use crate::diagnosis::BadNode;
 use crate::domain::{Face, Motion};
 use crate::kernel::{MacroOut, SyncPtr};
 use crate::kernel_aa::{self, Bad, CtxAa};
@@ -13,7 +14,7 @@ use crate::lattice::Lattice;
 use crate::layout::Layout;
 use crate::plan::Plan;
 use crate::real::Real;
-use crate::stepper::{Fluid, ForceTorque, Macro, Settings, likely_cause};
+use crate::stepper::{Fluid, ForceTorque, Macro, Settings, make_local};
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -32,6 +33,10 @@ pub enum Partition {
 pub struct StepperAa<L: Lattice, T: Real> {
     settings: Settings,
     params: CollideParams<T>,
+    /// Per-node rates (`set_local_tau`) and the τ they came from (diagnosis).
+    local: Option<(Vec<NodeRates<T>>, Vec<f64>)>,
+    /// Nodes of the lattice.
+    nodes: usize,
     plan: Plan,
     /// Layout of `fluid.f` between `new` and `finish` (padded, see `layout`).
     layout: Layout,
@@ -43,6 +48,43 @@ pub struct StepperAa<L: Lattice, T: Real> {
     pub partition: Partition,
     pub forces: Vec<ForceTorque>,
     _l: PhantomData<L>,
+}
+
+/// Every row of one AA step with the collision `C`, spread over the pool by `partition`.
+fn run_rows_aa<L: Lattice, T: Real, C: crate::collision::Collider<L, T>>(
+    bad: &mut [Bad],
+    ctx: &CtxAa<T, C>,
+    partition: Partition,
+    odd: bool,
+    forced: bool,
+) {
+    let work = |(c, flags): (usize, &mut [Bad]), rows: usize| {
+        for (k, b) in flags.iter_mut().enumerate() {
+            let r = c * rows + k;
+            // SAFETY: every node touches only its own slots (kernel_aa module doc).
+            *b = unsafe {
+                match (odd, forced) {
+                    (true, true) => kernel_aa::odd_row::<L, T, C, true>(ctx, r),
+                    (true, false) => kernel_aa::odd_row::<L, T, C, false>(ctx, r),
+                    (false, true) => kernel_aa::even_row::<L, T, C, true>(ctx, r),
+                    (false, false) => kernel_aa::even_row::<L, T, C, false>(ctx, r),
+                }
+            };
+        }
+    };
+    match partition {
+        Partition::Rows(k) => {
+            let k = k.max(1);
+            bad.par_chunks_mut(k).enumerate().for_each(|t| work(t, k));
+        }
+        Partition::Contiguous => {
+            let k = bad.len().div_ceil(rayon::current_num_threads());
+            bad.par_chunks_mut(k)
+                .with_max_len(1)
+                .enumerate()
+                .for_each(|t| work(t, k));
+        }
+    }
 }
 
 fn swap_pairs<L: Lattice, T: Real>(f: &mut [T], n: usize) {
@@ -85,6 +127,8 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         Ok(Self {
             settings,
             params: CollideParams::new(&settings.collision, settings.force)?,
+            local: None,
+            nodes: n,
             plan: Plan::build::<L>(dom, fluid.obstacles.len()),
             layout,
             bad: vec![None; dom.n[1] * dom.n[2]],
@@ -109,19 +153,60 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         Ok(())
     }
 
-    /// The populations of `fluid` in the canonical layout (post-collision, slot i = f_i, as
-    /// `Fluid::f` holds them before `new`), without giving the fluid back: for checkpoints.
-    /// Only after an even number of steps.
+    /// The populations in the canonical layout of `Fluid::f` (post-collision, slot i = f_i, node
+    /// order), without giving the fluid back: after an even number of steps only (at an odd one
+    /// the array holds streamed, pre-collision values). A `Fluid` with these populations, the
+    /// same domain, obstacles and `step`, taken by a new `StepperAa` (or a two-array `Stepper`)
+    /// continues the run bit for bit: this is the state a checkpoint stores.
     pub fn canonical(&self, fluid: &Fluid<L, T>) -> Result<Vec<T>, LbmError> {
         if !self.reversed {
             return Err(LbmError::Unsupported(
-                "AA populations asked for after an odd number of steps: take one more step first".into(),
+                "AA state exported after an odd number of steps: take one more step first (the array \
+                 then holds post-collision populations)"
+                    .into(),
             ));
         }
         let n = fluid.nodes();
         let mut f = self.layout.unpack(&fluid.f, L::Q, n);
         swap_pairs::<L, T>(&mut f, n);
         Ok(f)
+    }
+
+    /// A copy of `fluid` in the canonical layout (see [`StepperAa::canonical`]): the plain data
+    /// to serialise for a checkpoint.
+    pub fn export(&self, fluid: &Fluid<L, T>) -> Result<Fluid<L, T>, LbmError> {
+        let f = self.canonical(fluid)?;
+        let mut out = Fluid::new(fluid.domain.clone(), fluid.obstacles.clone());
+        out.f = f;
+        out.step = fluid.step;
+        Ok(out)
+    }
+
+    /// Relax node x with τ⁺ = `tau[x]` (node order); see `Stepper::set_local_tau`.
+    pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), LbmError> {
+        let nodes = self.nodes();
+        self.local = Some(make_local::<T>(
+            &self.settings.collision,
+            &mut self.params,
+            tau,
+            nodes,
+        )?);
+        Ok(())
+    }
+
+    /// Back to the settings' uniform τ.
+    pub fn clear_local_tau(&mut self) {
+        self.local = None;
+        self.params.bgk = self
+            .settings
+            .collision
+            .rates()
+            .map(|(p, m)| p == m)
+            .unwrap_or(true);
+    }
+
+    fn nodes(&self) -> usize {
+        self.nodes
     }
 
     /// The padded layout the array is kept in between `new` and `finish`.
@@ -146,58 +231,66 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
                 u: SyncPtr(m.u.as_mut_ptr()),
             }
         });
-        let ctx = CtxAa {
-            dom: &fluid.domain,
-            plan: &self.plan,
-            // slot 0 of the layout (the kernel's offsets do not include `base`)
-            f: SyncPtr(fluid.f[self.layout.base..].as_mut_ptr()),
-            layout: self.layout,
-            params: self.params,
-            motions: &self.motions,
-            limits: self.settings.limits.in_precision::<T>(),
-            out,
-        };
+        let limits = self.settings.limits.in_precision::<T>();
+        let f = SyncPtr(fluid.f[self.layout.base..].as_mut_ptr());
         let odd = self.reversed;
         let forced = self.settings.force.iter().any(|&x| x != 0.0);
-        let work = |(c, flags): (usize, &mut [Bad]), rows: usize| {
-            for (k, b) in flags.iter_mut().enumerate() {
-                let r = c * rows + k;
-                // SAFETY: every node touches only its own slots (kernel_aa module doc).
-                *b = unsafe {
-                    match (odd, forced) {
-                        (true, true) => kernel_aa::odd_row::<L, T, true>(&ctx, r),
-                        (true, false) => kernel_aa::odd_row::<L, T, false>(&ctx, r),
-                        (false, true) => kernel_aa::even_row::<L, T, true>(&ctx, r),
-                        (false, false) => kernel_aa::even_row::<L, T, false>(&ctx, r),
-                    }
+        let (dom, plan, motions, layout, partition) = (
+            &fluid.domain,
+            &self.plan,
+            &self.motions,
+            self.layout,
+            self.partition,
+        );
+        match &self.local {
+            None => {
+                let ctx = CtxAa {
+                    dom,
+                    plan,
+                    f,
+                    layout,
+                    coll: self.params,
+                    motions,
+                    limits,
+                    out,
                 };
+                run_rows_aa::<L, T, _>(&mut self.bad, &ctx, partition, odd, forced);
             }
-        };
-        match self.partition {
-            Partition::Rows(k) => {
-                let k = k.max(1);
-                self.bad.par_chunks_mut(k).enumerate().for_each(|t| work(t, k));
-            }
-            Partition::Contiguous => {
-                let k = self.bad.len().div_ceil(rayon::current_num_threads());
-                self.bad
-                    .par_chunks_mut(k)
-                    .with_max_len(1)
-                    .enumerate()
-                    .for_each(|t| work(t, k));
+            Some((rates, _)) => {
+                let ctx = CtxAa {
+                    dom,
+                    plan,
+                    // slot 0 of the layout (the kernel's offsets do not include `base`)
+                    f,
+                    layout,
+                    coll: LocalRates {
+                        base: self.params,
+                        rates,
+                    },
+                    motions,
+                    limits,
+                    out,
+                };
+                run_rows_aa::<L, T, _>(&mut self.bad, &ctx, partition, odd, forced);
             }
         }
         self.reversed = !self.reversed;
         fluid.step += 1;
         if let Some((r, Some((x, rho, u)))) = self.bad.iter().enumerate().find(|(_, b)| b.is_some()) {
             let ny = fluid.domain.n[1];
-            return Err(LbmError::Unstable {
+            let node = [*x, r % ny, r / ny];
+            let tau = match &self.local {
+                Some((_, t)) => t[fluid.domain.index(node[0], node[1], node[2])],
+                None => self.settings.collision.tau(),
+            };
+            return Err(BadNode {
                 step: fluid.step,
-                node: [*x, r % ny, r / ny],
+                node,
                 rho: *rho,
                 u: *u,
-                cause: likely_cause(self.settings.collision.tau(), *rho, *u, &self.settings.limits),
-            });
+                tau,
+            }
+            .into_error(&self.settings.limits));
         }
         Ok(())
     }

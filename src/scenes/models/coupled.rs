@@ -84,19 +84,15 @@ impl<T: Real> CoupledModel<T> {
         };
         let hydro = match cs.method {
             Method::Psm => {
-                let mut fluid = PsmFluid::<T>::new(
+                let fluid = PsmFluid::<T>::new(
                     &domain,
                     PsmSettings {
-                        tau,
+                        collision: su.collision,
                         force: [su.force[0], su.force[1]],
                         limits,
                     },
-                )?;
-                if let Some(m) = trt {
-                    fluid = fluid
-                        .with_trt(m)
-                        .map_err(|e| anyhow::anyhow!("[lattice] magic: {e}"))?;
-                }
+                )
+                .map_err(|e| anyhow::anyhow!("[lattice] collision / magic: {e}"))?;
                 Hydro::psm(fluid)
             }
             Method::BounceBack => {
@@ -303,9 +299,10 @@ impl<T: Real> Model for CoupledModel<T> {
         })
     }
     fn save(&self) -> Result<serde_json::Value> {
-        bail!("TODO(merge): coupled checkpoints come with the coupling crate's state export")
+        Ok(serde_json::to_value(self.run.state())?)
     }
-    fn restore(&mut self, _state: serde_json::Value) -> Result<()> {
-        bail!("TODO(merge): coupled checkpoints come with the coupling crate's state export")
+    fn restore(&mut self, state: serde_json::Value) -> Result<()> {
+        self.run.restore(serde_json::from_value(state)?)?;
+        Ok(())
     }
 }

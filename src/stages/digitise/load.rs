@@ -36,9 +36,7 @@ pub fn load(path: &Path, channel: Channel) -> Result<Loaded> {
         );
     }
     let is_tiff = bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*");
-    if is_tiff
-        && let Some(l) = load_float_tiff(path)?
-    {
+    if is_tiff && let Some(l) = load_float_tiff(path)? {
         return Ok(l);
     }
     let img = image::load_from_memory(&bytes).with_context(|| {

@@ -14,13 +14,6 @@ use serde::{Deserialize, Serialize};
 /// c_s² in lattice units.
 pub const CS2: f64 = 1.0 / 3.0;
 
-/// Mach number above which a set-up gets a warning (Su et al. 2020, after He et al.: Ma < 0.1).
-/// The one default every scene and study uses.
-pub const MACH_WARN: f64 = 0.1;
-
-/// Mach number above which a set-up is refused.
-pub const MACH_MAX: f64 = 0.3;
-
 /// How the time step is fixed.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -30,6 +23,21 @@ pub enum TimeSpec {
     /// Relaxation time τ (dimensionless); dt = c_s²(τ − ½) dx²/ν.
     Tau(f64),
 }
+
+/// Mach number above which a set-up is warned about (Su et al. 2020 Eq. 16, after He et al.):
+/// the one default every scene and stepper refers to.
+pub const MACH_WARN: f64 = 0.1;
+/// Mach number above which a set-up is refused.
+pub const MACH_MAX: f64 = 0.3;
+/// Default cell Reynolds number u_max dx/ν above which a warning is given.
+pub const RE_CELL_WARN: f64 = 10.0;
+/// Default accepted range of a running lattice (`lbdem_lbm::Limits::default`): density within a
+/// factor 2 of the reference 1 ...
+pub const RHO_MIN: f64 = 0.5;
+pub const RHO_MAX: f64 = 2.0;
+/// ... and |u| < 0.4 in lattice units (Ma ≈ 0.69, far beyond any accurate run; Su Eq. 16 asks
+/// Ma < 0.1): beyond it a run is stopped with a diagnosis.
+pub const U_MAX: f64 = 0.4;
 
 /// What a scene states in SI.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -63,13 +71,13 @@ impl LatticeInput {
             time,
             mach_warn: MACH_WARN,
             mach_max: MACH_MAX,
-            re_cell_warn: 10.0,
+            re_cell_warn: RE_CELL_WARN,
         }
     }
 }
 
 /// The derived lattice units.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LatticeUnits {
     pub dx: f64,
     pub dt: f64,
@@ -96,6 +104,11 @@ pub enum UnitsError {
          would be zero or negative); raise tau, or raise dt / lower dx so that tau = 0.5 + 3 nu dt/dx^2 > 0.5"
     )]
     Tau { tau: f64 },
+    #[error(
+        "LBM-DEM time-step ratio dt_lbm / dt_dem = {ratio} must be a whole number >= 1 \
+         (Su et al. 2020 Table 3); set dt_dem = dt_lbm / N for a whole N"
+    )]
+    Ratio { ratio: f64 },
     #[error(
         "Mach number Ma = {mach:.3} (u_max = {u_max} m/s, dt = {dt:e} s, dx = {dx:e} m, Su et al. 2020 \
          Eq. 16) is above the limit {limit}; lower dt (tau closer to 0.5) or coarsen dx so that \

@@ -4,5 +4,6 @@
 //! module refuses parameter sets that cannot be stable or accurate, with an error
 //! naming the parameter, its value, the limit and the fix.
 
+pub mod coupled;
 pub mod dem;
 pub mod lattice;

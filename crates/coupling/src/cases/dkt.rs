@@ -128,7 +128,7 @@ pub fn run<T: Real>(spec: &DktSpec) -> Result<DktResult, CouplingError> {
     let mut fluid = PsmFluid::<T>::new(
         &domain,
         PsmSettings {
-            tau: spec.tau,
+            collision: lbdem_lbm::Collision::Bgk { tau: spec.tau },
             force: [0.0; 2],
             limits: Limits::default(),
         },

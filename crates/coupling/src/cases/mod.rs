@@ -30,8 +30,7 @@ pub(crate) fn closed_box(
     ratio: u32,
 ) -> Result<ClosedBox, CouplingError> {
     let (nx, ny) = ((w / dx).round() as usize, (h / dx).round() as usize);
-    let lattice = LatticeUnits::derive(&LatticeInput::new(dx, nu, rho_f, u_max, TimeSpec::Tau(tau)))
-        .map_err(|e| CouplingError::Unsupported(e.to_string()))?;
+    let lattice = LatticeUnits::derive(&LatticeInput::new(dx, nu, rho_f, u_max, TimeSpec::Tau(tau)))?;
     let dt = lattice.dt;
     let units = CouplingUnits::new(lattice, [0.0, 0.0], dt / ratio as f64)?;
     let wall = Face::Wall { velocity: [0.0; 3] };

@@ -109,7 +109,7 @@ pub fn run<T: Real>(spec: &SettlingSpec) -> Result<SettlingResult, CouplingError
         Method::Psm => Hydro::psm(PsmFluid::<T>::new(
             &domain,
             PsmSettings {
-                tau: spec.tau,
+                collision: lbdem_lbm::Collision::Bgk { tau: spec.tau },
                 force: [0.0; 2],
                 limits,
             },

@@ -20,7 +20,7 @@ pub fn walled_box(nx: usize, ny: usize, tau: f64) -> PsmFluid<f64> {
 
 pub fn settings(tau: f64, force: [f64; 2]) -> PsmSettings {
     PsmSettings {
-        tau,
+        collision: lbdem_lbm::Collision::Bgk { tau },
         force,
         limits: Limits::default(),
     }
