@@ -5,6 +5,7 @@
 //! each law its own records back. A store holds the layout of one law at a time: viewed with a
 //! type of another stride, its records restart from `H::default()`.
 
+use crate::contact::History;
 use bytemuck::Pod;
 use serde::{Deserialize, Serialize};
 use std::fmt::Debug;
@@ -37,29 +38,33 @@ pub struct Histories {
 
 /// The serialised form, checked on the way in.
 #[derive(Deserialize)]
-struct RawHistories {
-    stride: usize,
-    len: usize,
-    data: Vec<f64>,
+#[serde(untagged)]
+enum RawHistories {
+    Slots {
+        stride: usize,
+        len: usize,
+        data: Vec<f64>,
+    },
+    /// Checkpoints written before histories were law-agnostic: a list of [`History`].
+    Legacy(Vec<History>),
 }
 
 impl TryFrom<RawHistories> for Histories {
     type Error = String;
     fn try_from(r: RawHistories) -> Result<Self, String> {
-        if r.stride.checked_mul(r.len) != Some(r.data.len()) {
-            return Err(format!(
-                "contact histories: {} records of {} slots need {} numbers, found {}",
-                r.len,
-                r.stride,
-                r.stride.saturating_mul(r.len),
-                r.data.len()
-            ));
+        match r {
+            RawHistories::Legacy(h) => Ok(Self::from_slice(&h)),
+            RawHistories::Slots { stride, len, data } => {
+                if stride.checked_mul(len) != Some(data.len()) {
+                    return Err(format!(
+                        "contact histories: {len} records of {stride} slots need {} numbers, found {}",
+                        stride.saturating_mul(len),
+                        data.len()
+                    ));
+                }
+                Ok(Self { stride, len, data })
+            }
         }
-        Ok(Self {
-            stride: r.stride,
-            len: r.len,
-            data: r.data,
-        })
     }
 }
 
@@ -154,5 +159,32 @@ impl Histories {
             };
         }
         bytemuck::cast_slice_mut(&mut self.data)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vector::Vec2;
+
+    #[test]
+    fn reads_both_forms_and_refuses_a_short_record_list() {
+        let h = History {
+            xi_t: Vec2::new(0.1, -2.5e-7),
+            theta_r: 3.0,
+            delta_p: 0.0,
+        };
+        let new = Histories::from_slice(&[h, History::default()]);
+        let json = serde_json::to_string(&new).unwrap();
+        let back: Histories = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, new);
+        let legacy: Histories =
+            serde_json::from_str(&serde_json::to_string(&[h, History::default()]).unwrap()).unwrap();
+        assert_eq!(legacy, new);
+        assert_eq!(legacy.as_slice::<History>(), Some(&[h, History::default()][..]));
+        assert_eq!(legacy.as_slice::<[f64; 2]>(), None);
+        let bad = r#"{"stride": 4, "len": 2, "data": [1.0, 2.0]}"#;
+        let err = serde_json::from_str::<Histories>(bad).unwrap_err().to_string();
+        assert!(err.contains("need 8 numbers, found 2"), "{err}");
     }
 }

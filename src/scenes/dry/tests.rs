@@ -72,11 +72,8 @@ fn resumed_run_matches_uninterrupted_bitwise() {
     assert!(fa.bodies == fb.bodies && fa.walls == fb.walls && fa.step == fb.step && fa.time == fb.time);
     let touching = |s: &lbdem_dem::System| -> Vec<_> {
         s.contacts
-            .pairs
-            .iter()
-            .zip(&s.contacts.hist)
-            .filter(|(_, h)| **h != Default::default())
-            .map(|(p, h)| (*p, *h))
+            .pairs_with_history()
+            .map(|(p, h)| (p, h.to_vec()))
             .collect()
     };
     assert_eq!(touching(&fa), touching(&fb));

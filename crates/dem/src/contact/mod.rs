@@ -181,7 +181,7 @@ impl Rolling {
 /// [`Law::visit`].
 macro_rules! register_laws {
     ($($(#[$meta:meta])* $variant:ident($ty:ty) = $name:literal,)+) => {
-        /// The laws a scene can choose (`[contact] law = "linear" | "hertz" | "plastic"`).
+        #[doc = concat!("The laws a scene can choose (`[contact] law = \"<name>\"`, the law's fields beside it):", $(" `", $name, "`",)+ ".")]
         #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
         #[serde(tag = "law", rename_all = "snake_case")]
         pub enum Law {
