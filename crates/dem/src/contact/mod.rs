@@ -62,7 +62,7 @@ pub struct ContactOutput {
 /// A contact law: force from overlap (or gap) and relative motion, updating its own history.
 ///
 /// Adding a law: one file in `contact/` with a struct implementing this trait, plus one line in
-/// the [`register_laws!`] list below if scenes should select it by name. The stepper's generic
+/// the `register_laws!` list below if scenes should select it by name. The stepper's generic
 /// pair pass is monomorphised over the law (its `force` inlines into the loop); nothing in the
 /// stepper or the batched kernels changes.
 pub trait ContactLaw: Sync + Send {
