@@ -241,3 +241,36 @@ fn registered_laws_keep_their_scene_names() {
             .starts_with(r#"{"law":"linear","#)
     );
 }
+
+#[test]
+fn step_law_dispatch_matches_the_enum_law_bitwise() {
+    // `step_law` runs the pass monomorphised for the pair law's variant (its own history type),
+    // the wall law through the enum; `step::<Law, Law>` dispatches every contact through the
+    // enum (LawHistory records). Same bits, different wall and pair laws.
+    let (s0, lin, p) = common::clumps_in_walled_box(20.0, 200, 11);
+    let mut pl = LinearSpringDashpot::new(1e4, 4e3, Damping::Ratio(0.2), 0.4);
+    pl.rolling = Some(contact::Rolling { k_r: 20.0, mu_r: 0.1 });
+    let (law, wall_law) = (Law::Linear(pl), Law::Linear(lin));
+    let (mut a, mut b) = (s0.clone(), s0);
+    let (mut sa, mut sb) = (Stepper::new(), Stepper::new());
+    for _ in 0..6000 {
+        sa.step_law(&p, &law, &wall_law, &mut a).unwrap();
+        sb.step(&p, &law, &wall_law, &mut b).unwrap();
+    }
+    assert!(
+        sa.n_contacts() > 50 && a.walls[2].n_contacts > 0,
+        "{}",
+        sa.n_contacts()
+    );
+    assert_eq!(common::bits(&a), common::bits(&b));
+    let ha: Vec<_> = a.contacts.pairs_with_history().collect();
+    let hb: Vec<_> = b.contacts.pairs_with_history().collect();
+    println!(
+        "{} pairs in contact, {} with history, {} floor contacts",
+        sa.n_contacts(),
+        ha.len(),
+        a.walls[2].n_contacts
+    );
+    assert!(ha.len() > 50);
+    assert_eq!(ha, hb);
+}
