@@ -174,7 +174,8 @@ pub fn carry_history<H: Copy + Default>(
     out
 }
 
-/// [`carry_history`] into `out` (one record per new pair, already fresh).
+/// [`carry_history`] into `out` (one record per new pair, already fresh). Old pairs without a
+/// history record (a short `old_hist`) carry nothing.
 pub fn carry_history_into<H: Copy>(
     old_pairs: &[[u32; 2]],
     old_hist: &[H],
@@ -186,8 +187,11 @@ pub fn carry_history_into<H: Copy>(
         while k < old_pairs.len() && old_pairs[k] < *p {
             k += 1;
         }
-        if k < old_pairs.len() && old_pairs[k] == *p {
-            *h = old_hist[k];
+        if k < old_pairs.len()
+            && old_pairs[k] == *p
+            && let Some(o) = old_hist.get(k)
+        {
+            *h = *o;
         }
     }
 }
