@@ -98,3 +98,37 @@ fn layer_check_sees_a_bad_import() {
     assert_eq!(refs, vec!["pipeline".to_string()]);
     assert!(layer_of("pipeline") > layer_of("stages"));
 }
+
+#[test]
+fn engine_kernels_import_nothing_from_their_steppers() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates");
+    let kernels = [
+        "dem/src/pair_linear.rs",
+        "dem/src/kick_disks.rs",
+        "dem/src/scratch.rs",
+        "lbm/src/kernel.rs",
+        "lbm/src/kernel_aa.rs",
+        "lbm/src/collision.rs",
+    ];
+    for k in kernels {
+        let text = std::fs::read_to_string(root.join(k)).unwrap();
+        let refs = crate_refs(&text);
+        assert!(
+            !refs.iter().any(|r| r == "stepper" || r == "stepper_aa"),
+            "{k} imports its stepper: {refs:?}"
+        );
+    }
+}
+
+#[test]
+fn engine_crates_do_no_file_io() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates");
+    for krate in ["dem", "lbm", "coupling", "imaging", "grains"] {
+        for f in rust_files(&root.join(krate).join("src")) {
+            let text = std::fs::read_to_string(&f).unwrap();
+            for bad in ["std::fs::", "File::open", "File::create"] {
+                assert!(!text.contains(bad), "{} uses {bad}", f.display());
+            }
+        }
+    }
+}

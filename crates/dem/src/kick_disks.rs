@@ -1,11 +1,11 @@
 //! The opening half kick, drift, periodic wrap and circle lines of eight disks at a time (the
 //! all-disk path of the stepper). The same IEEE operations in the same order as the scalar loop
-//! in `stepper.rs` (same bits); a batch in which a disk left the box by more than one length is
+//! in `stepper/kick.rs` (same bits); a batch in which a disk left the box by more than one length is
 //! left to that loop.
 
 use crate::domain::Domain;
 use crate::lanes::{F8, W, deinterleave, interleave, transpose};
-use crate::stepper::CircleState;
+use crate::scratch::CircleState;
 use crate::vector::Vec2;
 
 /// Box constants of one pass.
@@ -121,7 +121,7 @@ impl DiskKick {
                 pad: 0.0,
             };
         }
-        Some(d2.into_iter().fold(0.0, crate::stepper::nan_max))
+        Some(d2.into_iter().fold(0.0, crate::scratch::nan_max))
     }
 }
 
@@ -198,7 +198,7 @@ mod tests {
                         hi[k],
                         refp[k],
                     );
-                    worst = crate::stepper::nan_max(worst, d);
+                    worst = crate::scratch::nan_max(worst, d);
                 }
                 let mut st = [CircleState::default(); W];
                 let got = DiskKick::new(&dom, dt).eight(Eight {

@@ -2,17 +2,21 @@
 //! (Sects. 2.3-2.4, Table 1), Ness et al. 2017 (Eq. 6) and Leonardi et al. 2014 (Sect. 3).
 //!
 //! State is plain data ([`System`]: [`Bodies`], walls, bonds, [`Contacts`]); the [`Stepper`] is
-//! scratch. Contact laws implement [`ContactLaw`]. No file I/O here.
+//! scratch. Contact laws implement [`ContactLaw`] (each with its own range and history type) and
+//! are registered for scenes in [`Law`]; callers add forces through a [`ForceHook`]. No file
+//! I/O here.
 
 pub mod body;
 pub mod contact;
 pub mod domain;
 pub mod error;
 pub mod generate;
+pub mod history;
 mod kick_disks;
 mod lanes;
 pub mod neighbor;
 mod pair_linear;
+mod scratch;
 pub mod shape;
 pub mod stepper;
 pub mod system;
@@ -20,12 +24,13 @@ pub mod vector;
 pub mod wall;
 
 pub use body::Bodies;
-pub use contact::{ContactLaw, Damping, History, Law};
+pub use contact::{ContactLaw, Damping, History, Law, LawVisitor};
 pub use domain::Domain;
 pub use error::DemError;
+pub use history::{Histories, HistoryData};
 pub use neighbor::Contacts;
 pub use shape::{Ball, ClumpShape, MassProps2};
-pub use stepper::{StepParams, Stepper};
+pub use stepper::{ForceHook, StepParams, Stepper};
 pub use system::{Membrane, System};
 pub use vector::{Vec2, Vector};
 pub use wall::{ServoLength, Wall, WallMotion, WallShape};

@@ -1,11 +1,12 @@
 //! Broad phase: a cell list (circles counting-sorted by cell) builds a Verlet pair list with a
 //! skin. Pairs are kept in canonical order (i < j, sorted), so the per-particle gather sums in
 //! a fixed order whatever the thread count or the step at which the list was rebuilt; the
-//! tangential/rolling history of each pair is carried over to the new list by a merge.
+//! history of each pair (whatever the law's history type) is carried over to the new list by a
+//! merge.
 
-use crate::contact::History;
 use crate::domain::Domain;
 use crate::error::DemError;
+use crate::history::Histories;
 use crate::vector::Vec2;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -14,9 +15,24 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Contacts {
     pub pairs: Vec<[u32; 2]>,
-    pub hist: Vec<History>,
-    /// History of circle-wall contacts, `c * n_walls + w`.
-    pub wall_hist: Vec<History>,
+    /// History of each pair under the pair law (`hist.as_slice::<L::History>()`).
+    pub hist: Histories,
+    /// History of circle-wall contacts under the wall law, `c * n_walls + w`.
+    pub wall_hist: Histories,
+}
+
+impl Contacts {
+    /// Pairs whose history is not the fresh state (some slot != 0.0), with their raw history
+    /// slots, in list order: the pairs in contact (or in range) that carry state. Pairs that do
+    /// not interact carry no history, so two runs that differ only in their candidate lists
+    /// give the same sequence.
+    pub fn pairs_with_history(&self) -> impl Iterator<Item = ([u32; 2], &[f64])> + '_ {
+        self.pairs
+            .iter()
+            .zip(self.hist.records())
+            .filter(|(_, h)| h.iter().any(|&x| x != 0.0))
+            .map(|(p, h)| (*p, h))
+    }
 }
 
 /// Fixed chunk of circles per parallel task while building the list.
@@ -42,9 +58,23 @@ impl CellList {
         body: &[u32],
         skin: f64,
     ) -> Result<Vec<[u32; 2]>, DemError> {
+        self.build_pairs_in_range(dom, pos, r, body, skin, |_, _| 0.0)
+    }
+
+    /// [`CellList::build_pairs`] for a law acting across gaps up to `range(r_i, r_j)`: pairs
+    /// closer than r_i + r_j + range + skin (`range` non-decreasing in the radii).
+    pub fn build_pairs_in_range(
+        &mut self,
+        dom: &Domain,
+        pos: &[Vec2],
+        r: &[f64],
+        body: &[u32],
+        skin: f64,
+        range: impl Fn(f64, f64) -> f64 + Sync,
+    ) -> Result<Vec<[u32; 2]>, DemError> {
         let n = pos.len();
         let rmax = r.iter().copied().fold(0.0, f64::max);
-        let cut = 2.0 * rmax + skin;
+        let cut = 2.0 * rmax + range(rmax, rmax) + skin;
         let size = dom.size();
         let nx = ((size.x / cut).floor() as usize).max(1);
         let ny = ((size.y / cut).floor() as usize).max(1);
@@ -116,7 +146,8 @@ impl CellList {
                                 continue;
                             }
                             let d = dom.min_image(pos[j as usize] - pi);
-                            let rc = ri + r[j as usize] + skin;
+                            let rj = r[j as usize];
+                            let rc = ri + rj + range(ri, rj) + skin;
                             if d.x * d.x + d.y * d.y < rc * rc {
                                 nb.push(j);
                             }
@@ -133,18 +164,36 @@ impl CellList {
 }
 
 /// Carry history from `(old_pairs, old_hist)` onto `new_pairs` (both sorted); new pairs start empty.
-pub fn carry_history(old_pairs: &[[u32; 2]], old_hist: &[History], new_pairs: &[[u32; 2]]) -> Vec<History> {
-    let mut out = vec![History::default(); new_pairs.len()];
+pub fn carry_history<H: Copy + Default>(
+    old_pairs: &[[u32; 2]],
+    old_hist: &[H],
+    new_pairs: &[[u32; 2]],
+) -> Vec<H> {
+    let mut out = vec![H::default(); new_pairs.len()];
+    carry_history_into(old_pairs, old_hist, new_pairs, &mut out);
+    out
+}
+
+/// [`carry_history`] into `out` (one record per new pair, already fresh). Old pairs without a
+/// history record (a short `old_hist`) carry nothing.
+pub fn carry_history_into<H: Copy>(
+    old_pairs: &[[u32; 2]],
+    old_hist: &[H],
+    new_pairs: &[[u32; 2]],
+    out: &mut [H],
+) {
     let mut k = 0;
     for (p, h) in new_pairs.iter().zip(out.iter_mut()) {
         while k < old_pairs.len() && old_pairs[k] < *p {
             k += 1;
         }
-        if k < old_pairs.len() && old_pairs[k] == *p {
-            *h = old_hist[k];
+        if k < old_pairs.len()
+            && old_pairs[k] == *p
+            && let Some(o) = old_hist.get(k)
+        {
+            *h = *o;
         }
     }
-    out
 }
 
 /// Brute-force reference (all pairs), for tests of the cell list.

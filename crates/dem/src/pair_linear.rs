@@ -7,7 +7,7 @@
 use crate::contact::{Damping, History, LinearSpringDashpot};
 use crate::domain::Domain;
 use crate::lanes::{F8, M8, W};
-use crate::stepper::{CircleState, PairOut};
+use crate::scratch::{CircleState, PairOut};
 
 /// The law and box constants of one force evaluation.
 #[derive(Clone, Copy, Debug)]
@@ -338,7 +338,7 @@ fn store4(o: &mut [PairOut; W], v: [F8; 4]) {
 mod x86 {
     use super::{F8, W};
     use crate::contact::History;
-    use crate::stepper::CircleState;
+    use crate::scratch::CircleState;
     use std::arch::x86_64::*;
 
     #[inline(always)]

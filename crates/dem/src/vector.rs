@@ -35,7 +35,9 @@ pub trait Vector:
 }
 
 /// A 2D vector of f64 (`repr(C)`: x then y; the pair kernel loads them as a line).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 pub struct Vec2 {
     pub x: f64,

@@ -81,10 +81,18 @@ impl Wall {
     /// Overlap and unit normal from the circle towards the wall, if touching.
     #[inline]
     pub fn touch(&self, c: Vec2, r: f64) -> Option<(f64, Vec2)> {
+        self.touch_within(c, r, 0.0)
+    }
+
+    /// [`Wall::touch`] for a law acting across a gap up to `range`: also a circle whose gap to
+    /// the wall is below `range` (overlap < 0 then).
+    #[inline]
+    pub fn touch_within(&self, c: Vec2, r: f64, range: f64) -> Option<(f64, Vec2)> {
+        let reach = r + range;
         match self.shape {
             WallShape::Plane { p, n } => {
                 let d = (c - p).dot(n);
-                (d < r).then_some((r - d, -n))
+                (d < reach).then_some((r - d, -n))
             }
             WallShape::Segment { a, b } => {
                 let ab = b - a;
@@ -92,7 +100,7 @@ impl Wall {
                 let q = a + ab * t;
                 let d = c - q;
                 let dist = d.norm();
-                (dist < r && dist > 0.0).then(|| (r - dist, d * (-1.0 / dist)))
+                (dist < reach && dist > 0.0).then(|| (r - dist, d * (-1.0 / dist)))
             }
         }
     }

@@ -51,7 +51,12 @@ fn identical_for_one_and_two_threads() {
     };
     let (a, b) = (go(1), go(2));
     assert!(
-        a.contacts.hist.iter().any(|h| h.xi_t.norm() > 0.0),
+        a.contacts
+            .hist
+            .as_slice::<History>()
+            .unwrap()
+            .iter()
+            .any(|h| h.xi_t.norm() > 0.0),
         "test must exercise tangential history"
     );
     assert_eq!(bits(&a), bits(&b));
@@ -192,7 +197,13 @@ fn clumps_with_walls_identical_for_one_and_two_threads() {
     };
     let (a, b) = (go(1), go(2));
     assert!(
-        a.walls[2].n_contacts > 0 && a.contacts.hist.iter().any(|h| h.xi_t.norm() > 0.0),
+        a.walls[2].n_contacts > 0
+            && a.contacts
+                .hist
+                .as_slice::<History>()
+                .unwrap()
+                .iter()
+                .any(|h| h.xi_t.norm() > 0.0),
         "grains must reach the floor and touch each other"
     );
     assert_eq!(bits(&a), bits(&b));

@@ -10,6 +10,7 @@ use lbdem_dem::*;
 struct Generic(LinearSpringDashpot);
 
 impl ContactLaw for Generic {
+    type History = History;
     fn force(&self, c: &ContactInput, h: &mut History) -> ContactOutput {
         self.0.force(c, h)
     }
@@ -49,6 +50,8 @@ fn sheared<L: ContactLaw>(law: &L, threads: usize) -> System {
 fn hist_bits(s: &System) -> Vec<u64> {
     s.contacts
         .hist
+        .as_slice::<History>()
+        .unwrap()
         .iter()
         .flat_map(|h| [h.xi_t.x, h.xi_t.y, h.theta_r, h.delta_p].map(f64::to_bits))
         .collect()
@@ -61,7 +64,14 @@ fn batched_kernel_matches_generic_loop_bitwise() {
     ratio.clip = false;
     for law in [gamma, ratio] {
         let (a, b) = (sheared(&law, 1), sheared(&Generic(law), 1));
-        let sliding = a.contacts.hist.iter().filter(|h| h.xi_t.norm() > 0.0).count();
+        let sliding = a
+            .contacts
+            .hist
+            .as_slice::<History>()
+            .unwrap()
+            .iter()
+            .filter(|h| h.xi_t.norm() > 0.0)
+            .count();
         assert!(
             sliding > 50,
             "test must exercise tangential history: {sliding} pairs"
@@ -100,7 +110,12 @@ fn batched_kernel_matches_generic_loop_for_clumps() {
     let g = Generic(law);
     let b = go(&|st, s| st.step(&p, &g, &g, s).unwrap());
     assert!(
-        a.contacts.hist.iter().any(|h| h.xi_t.norm() > 0.0),
+        a.contacts
+            .hist
+            .as_slice::<History>()
+            .unwrap()
+            .iter()
+            .any(|h| h.xi_t.norm() > 0.0),
         "grains must touch each other"
     );
     assert_eq!(bits(&a), bits(&b));

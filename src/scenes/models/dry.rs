@@ -7,7 +7,7 @@ use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::write_particles;
 use crate::scenes::timeloop::{Model, Probe};
 use anyhow::{Context, Result};
-use lbdem_dem::{ContactLaw, Law, StepParams, Stepper, System, Vec2, Vector};
+use lbdem_dem::{Law, StepParams, Stepper, System, Vec2, Vector};
 use std::path::{Path, PathBuf};
 
 pub struct Dry {
@@ -76,12 +76,7 @@ impl Dry {
 }
 
 pub fn law_name(l: &Law) -> &'static str {
-    let _ = l.friction();
-    match l {
-        Law::Linear(_) => "linear",
-        Law::Hertz(_) => "hertz",
-        Law::Plastic(_) => "plastic",
-    }
+    l.name()
 }
 
 /// Series columns of a grain system with `walls` walls.

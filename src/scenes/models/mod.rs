@@ -13,9 +13,9 @@ use lbdem_dem::{Stepper, System};
 /// The touching pairs of the last force evaluation, for the contact table.
 pub fn contact_list(st: &Stepper, sys: &System) -> Vec<ContactForce> {
     st.contact_forces(sys)
-        .map(|(p, f)| ContactForce {
-            i: p[0],
-            j: p[1],
+        .map(|(i, j, f)| ContactForce {
+            i,
+            j,
             force: [f.x, f.y],
         })
         .collect()

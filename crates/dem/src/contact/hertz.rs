@@ -39,6 +39,7 @@ impl HertzMindlin {
 }
 
 impl ContactLaw for HertzMindlin {
+    type History = History;
     #[inline]
     fn force(&self, c: &ContactInput, _h: &mut History) -> ContactOutput {
         let k = self.prefactor(c.r_eff);

@@ -48,6 +48,7 @@ impl LinearSpringDashpot {
 }
 
 impl ContactLaw for LinearSpringDashpot {
+    type History = History;
     #[inline]
     fn force(&self, c: &ContactInput, h: &mut History) -> ContactOutput {
         let cn = self.damping.coefficient(self.k_n, c.m_eff);

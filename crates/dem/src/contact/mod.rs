@@ -10,6 +10,7 @@ pub mod hertz;
 pub mod linear;
 pub mod plastic;
 
+use crate::history::{HistoryData, stride_of};
 use crate::vector::{Vec2, Vector};
 use serde::{Deserialize, Serialize};
 
@@ -18,9 +19,11 @@ pub use hertz::HertzMindlin;
 pub use linear::LinearSpringDashpot;
 pub use plastic::ElasticPlastic;
 
-/// Persistent per-contact state carried between steps (`repr(C)`: the pair kernel loads four
-/// of them as two 512-bit lines).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+/// The history of the linear, Hertz and elastic-plastic laws (`repr(C)`: the batched linear pair
+/// kernel loads four of them as two 512-bit lines).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable,
+)]
 #[repr(C)]
 pub struct History {
     /// Tangential spring elongation.
@@ -34,6 +37,7 @@ pub struct History {
 /// Kinematics of one contact.
 #[derive(Clone, Copy, Debug)]
 pub struct ContactInput {
+    /// Overlap r_i + r_j − distance: negative across a gap (laws with a [`ContactLaw::range`]).
     pub delta: f64,
     pub n: Vec2,
     pub v_rel: Vec2,
@@ -55,18 +59,49 @@ pub struct ContactOutput {
     pub f_n: f64,
 }
 
-/// A contact law: force from overlap and relative motion, updating its history.
+/// A contact law: force from overlap (or gap) and relative motion, updating its own history.
+///
+/// Adding a law: one file in `contact/` with a struct implementing this trait, plus one line in
+/// the `register_laws!` list below if scenes should select it by name. The stepper's generic
+/// pair pass is monomorphised over the law (its `force` inlines into the loop); nothing in the
+/// stepper or the batched kernels changes.
 pub trait ContactLaw: Sync + Send {
-    fn force(&self, c: &ContactInput, h: &mut History) -> ContactOutput;
+    /// Per-contact state carried between steps (and across Verlet-list rebuilds and checkpoints,
+    /// stored as f64 slots: see [`crate::history`]). `Default` is a fresh contact; a pair that
+    /// leaves the law's range is reset to it.
+    type History: HistoryData;
+    fn force(&self, c: &ContactInput, h: &mut Self::History) -> ContactOutput;
     /// Largest normal stiffness (N/m) the law can present, for the critical time step.
     fn max_stiffness(&self, r_eff: f64) -> f64;
     /// Friction coefficient (for diagnostics and generation protocols).
     fn friction(&self) -> f64;
+    /// Gap (m) beyond touching within which the law acts between circles of radii `r_i`, `r_j`
+    /// (0: contact only). Pairs with a gap below it are evaluated with `delta < 0`; the Verlet
+    /// list reaches r_i + r_j + range + skin. Must not decrease with the radii (the cell size
+    /// uses `range(r_max, r_max)`).
+    #[inline]
+    fn range(&self, _r_i: f64, _r_j: f64) -> f64 {
+        0.0
+    }
+    /// The same between a circle of radius `r` and a wall (default 0: walls act on touching
+    /// circles only).
+    #[inline]
+    fn wall_range(&self, _r: f64) -> f64 {
+        0.0
+    }
     /// The law as the linear spring-dashpot, if it is one: the stepper then uses its batched
-    /// pair kernel (same bits as [`ContactLaw::force`]).
+    /// pair kernel (same bits as [`ContactLaw::force`]). Return `Some` only if `Self::History`
+    /// is laid out as [`History`] (the kernel reads and writes the records as `History`).
     fn linear(&self) -> Option<&LinearSpringDashpot> {
         None
     }
+}
+
+/// Calls `visit` with the concrete law inside a [`Law`] (static dispatch: the callee is
+/// monomorphised per registered law, as the stepper's pair pass is in `Stepper::step_law`).
+pub trait LawVisitor {
+    type Output;
+    fn visit<L: ContactLaw>(self, law: &L) -> Self::Output;
 }
 
 /// How the normal dashpot coefficient is set.
@@ -140,42 +175,113 @@ impl Rolling {
     }
 }
 
-/// The laws a scene can choose (`[contact] law = "linear" | "hertz" | "plastic"`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "law", rename_all = "snake_case")]
-pub enum Law {
-    Linear(LinearSpringDashpot),
-    Hertz(HertzMindlin),
-    Plastic(ElasticPlastic),
+/// Generates [`Law`] (the scene-selectable laws, serde `law = "<name>"` with the law's fields
+/// beside it), its [`ContactLaw`] impl (dispatch per variant; the history is [`LawHistory`], the
+/// largest registered history, each variant reading its own prefix), [`Law::name`] and
+/// [`Law::visit`].
+macro_rules! register_laws {
+    ($($(#[$meta:meta])* $variant:ident($ty:ty) = $name:literal,)+) => {
+        #[doc = concat!("The laws a scene can choose (`[contact] law = \"<name>\"`, the law's fields beside it):", $(" `", $name, "`",)+ ".")]
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(tag = "law", rename_all = "snake_case")]
+        pub enum Law {
+            $($(#[$meta])* #[serde(rename = $name)] $variant($ty),)+
+        }
+
+        /// f64 slots of the largest history of the registered laws.
+        pub const LAW_SLOTS: usize = max_slots(&[$(stride_of::<<$ty as ContactLaw>::History>()),+]);
+
+        impl Law {
+            /// The name a scene uses for the law.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(Law::$variant(_) => $name,)+
+                }
+            }
+
+            /// `v.visit(law)` with the concrete law.
+            #[inline]
+            pub fn visit<V: LawVisitor>(&self, v: V) -> V::Output {
+                match self {
+                    $(Law::$variant(l) => v.visit(l),)+
+                }
+            }
+        }
+
+        impl ContactLaw for Law {
+            type History = LawHistory;
+            #[inline]
+            fn force(&self, c: &ContactInput, h: &mut LawHistory) -> ContactOutput {
+                match self {
+                    $(Law::$variant(l) => l.force(c, h.prefix_mut::<<$ty as ContactLaw>::History>()),)+
+                }
+            }
+            fn max_stiffness(&self, r_eff: f64) -> f64 {
+                match self {
+                    $(Law::$variant(l) => l.max_stiffness(r_eff),)+
+                }
+            }
+            fn friction(&self) -> f64 {
+                match self {
+                    $(Law::$variant(l) => l.friction(),)+
+                }
+            }
+            #[inline]
+            fn range(&self, r_i: f64, r_j: f64) -> f64 {
+                match self {
+                    $(Law::$variant(l) => l.range(r_i, r_j),)+
+                }
+            }
+            #[inline]
+            fn wall_range(&self, r: f64) -> f64 {
+                match self {
+                    $(Law::$variant(l) => l.wall_range(r),)+
+                }
+            }
+            fn linear(&self) -> Option<&LinearSpringDashpot> {
+                match self {
+                    $(Law::$variant(l) => l.linear(),)+
+                }
+            }
+        }
+    };
 }
 
-impl ContactLaw for Law {
+// The registration list: one line per scene-selectable law.
+register_laws! {
+    Linear(LinearSpringDashpot) = "linear",
+    Hertz(HertzMindlin) = "hertz",
+    Plastic(ElasticPlastic) = "plastic",
+}
+
+const fn max_slots(s: &[usize]) -> usize {
+    let (mut m, mut k) = (0, 0);
+    while k < s.len() {
+        if s[k] > m {
+            m = s[k];
+        }
+        k += 1;
+    }
+    m
+}
+
+/// The history of [`Law`]: room for the largest registered history; each variant uses its own
+/// history type as a prefix (so with today's laws it is laid out as [`History`]).
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub struct LawHistory(pub [f64; LAW_SLOTS]);
+
+impl Default for LawHistory {
+    fn default() -> Self {
+        Self([0.0; LAW_SLOTS])
+    }
+}
+
+impl LawHistory {
+    /// The first `size_of::<H>()` bytes as `H`.
     #[inline]
-    fn force(&self, c: &ContactInput, h: &mut History) -> ContactOutput {
-        match self {
-            Law::Linear(l) => l.force(c, h),
-            Law::Hertz(l) => l.force(c, h),
-            Law::Plastic(l) => l.force(c, h),
-        }
-    }
-    fn max_stiffness(&self, r_eff: f64) -> f64 {
-        match self {
-            Law::Linear(l) => l.max_stiffness(r_eff),
-            Law::Hertz(l) => l.max_stiffness(r_eff),
-            Law::Plastic(l) => l.max_stiffness(r_eff),
-        }
-    }
-    fn friction(&self) -> f64 {
-        match self {
-            Law::Linear(l) => l.friction(),
-            Law::Hertz(l) => l.friction(),
-            Law::Plastic(l) => l.friction(),
-        }
-    }
-    fn linear(&self) -> Option<&LinearSpringDashpot> {
-        match self {
-            Law::Linear(l) => Some(l),
-            _ => None,
-        }
+    fn prefix_mut<H: HistoryData>(&mut self) -> &mut H {
+        const { assert!(stride_of::<H>() <= LAW_SLOTS) };
+        bytemuck::from_bytes_mut(&mut bytemuck::bytes_of_mut(self)[..size_of::<H>()])
     }
 }

@@ -46,6 +46,7 @@ impl ElasticPlastic {
 }
 
 impl ContactLaw for ElasticPlastic {
+    type History = History;
     #[inline]
     fn force(&self, c: &ContactInput, h: &mut History) -> ContactOutput {
         let f_el = self.normal(c.delta, h);
