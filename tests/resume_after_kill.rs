@@ -157,3 +157,27 @@ fn grains_in_liquid_resume_bitwise_after_sigkill() {
         ],
     );
 }
+
+/// Where resuming is impossible it is refused with a message, and nothing is written.
+#[test]
+fn resume_without_an_interrupted_run_is_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let scene = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dry-settle.toml"))
+        .unwrap();
+    let path = t.path().join("s.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = t.path().join("out");
+    let (ok, err) = run(&[
+        "simulate",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--resume",
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("no interrupted run") && err.contains("without --resume"),
+        "{err}"
+    );
+    assert!(!out.exists(), "a refused resume left {}", out.display());
+}

@@ -3,8 +3,8 @@
 
 use super::models;
 use super::observers::{Progress, Series, SlowerThan, Snapshots, Steady, WallClock, WallMoved};
-use super::schema::{Loaded, Physics, Scene};
-use super::timeloop::{self, LoopCfg, Model, Observer, Trigger};
+use super::schema::{Loaded, Physics, Scene, TriggerSpec, WallRef};
+use super::timeloop::{self, LoopCfg, Model, Observer, Probe, Trigger};
 use crate::contract::Table;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
@@ -37,13 +37,56 @@ pub fn total_steps(s: &Scene, dt: f64) -> u64 {
     }
 }
 
-/// The observers of the scene, in the order they act after a step.
-pub fn observers(s: &Scene, total: u64, name: &str) -> (Vec<Box<dyn Observer>>, Trigger) {
+/// The DEM index of a wall given by index (a box counts as four) or by its `name`.
+pub fn wall_index(s: &Scene, w: &WallRef) -> Result<usize> {
+    let count = |e: &super::schema::WallSection| if e.box_.is_some() { 4 } else { 1 };
+    let total: usize = s.walls.iter().map(count).sum();
+    match w {
+        WallRef::Index(k) if *k < total => Ok(*k),
+        WallRef::Index(k) => anyhow::bail!(
+            "wall = {k}, but the scene has {total} walls (a box counts as four: left, right, bottom, top)"
+        ),
+        WallRef::Name(n) => {
+            let mut k = 0;
+            for e in &s.walls {
+                if e.name.as_deref() == Some(n.as_str()) {
+                    if e.box_.is_some() {
+                        anyhow::bail!(
+                            "wall = \"{n}\" names a box (four walls); refer to one of them by index"
+                        );
+                    }
+                    return Ok(k);
+                }
+                k += count(e);
+            }
+            let names: Vec<&str> = s.walls.iter().filter_map(|e| e.name.as_deref()).collect();
+            anyhow::bail!("wall = \"{n}\": no [[walls]] entry has this name; named walls: {names:?}")
+        }
+    }
+}
+
+/// A trigger of `[output]`, with its condition resolved.
+fn trigger(s: &Scene, what: &str, t: &TriggerSpec, total: u64) -> Result<Trigger> {
+    let probe = match &t.when {
+        None => None,
+        Some(w) => Some(match (w.quantity.as_str(), &w.wall) {
+            ("wall_displacement", Some(r)) => {
+                Probe::WallDisplacement(wall_index(s, r).with_context(|| format!("[output] {what} when"))?)
+            }
+            ("max_grain_speed", _) => Probe::MaxGrainSpeed,
+            _ => Probe::MeanLiquidSpeed,
+        }),
+    };
+    Ok(Trigger::from_spec(t, total, probe))
+}
+
+/// The observers of the scene, in the order they act after a step, and the checkpoint trigger.
+pub fn observers(s: &Scene, total: u64) -> Result<(Vec<Box<dyn Observer>>, Trigger)> {
     let out = &s.output;
-    let series = Trigger::from_spec(&out.series, total);
+    let series = trigger(s, "series", &out.series, total)?;
     let mut obs: Vec<Box<dyn Observer>> = vec![
         Box::new(Series::new(series.clone())),
-        Box::new(Snapshots::new(Trigger::from_spec(&out.snapshots, total))),
+        Box::new(Snapshots::new(trigger(s, "snapshots", &out.snapshots, total)?)),
     ];
     let r = &s.run;
     if let Some(v) = r.until_slower_than {
@@ -59,9 +102,9 @@ pub fn observers(s: &Scene, total: u64, name: &str) -> (Vec<Box<dyn Observer>>, 
             last: None,
         }));
     }
-    if let Some(w) = r.until_wall_moved {
+    if let Some(w) = &r.until_wall_moved {
         obs.push(Box::new(WallMoved {
-            wall: w.wall,
+            wall: wall_index(s, &w.wall).context("[run] until_wall_moved")?,
             distance: w.distance,
             trigger: Trigger::Every(1),
         }));
@@ -73,25 +116,14 @@ pub fn observers(s: &Scene, total: u64, name: &str) -> (Vec<Box<dyn Observer>>, 
             trigger: Trigger::Every(1),
         }));
     }
-    obs.push(Box::new(Progress::new(total, 0, name)));
-    (obs, Trigger::from_spec(&out.checkpoints, total))
+    Ok((obs, trigger(s, "checkpoints", &out.checkpoints, total)?))
 }
 
 /// Run the loaded scene in `dir` (the runner's working directory).
 pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResult> {
     let s = &l.scene;
-    if let Some(w) = s.run.until_wall_moved
-        && w.wall
-            >= s.walls
-                .iter()
-                .map(|w| if w.box_.is_some() { 4 } else { 1 })
-                .sum::<usize>()
-    {
-        anyhow::bail!(
-            "[run] until_wall_moved: wall = {} but the scene has fewer walls (a box counts as four)",
-            w.wall
-        );
-    }
+    // Refuse a bad wall reference before anything is built or written.
+    observers(s, 1)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(s.run.threads)
         .build()
@@ -99,7 +131,8 @@ pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResul
     pool.install(|| {
         let mut m = model(l, resume)?;
         let total = total_steps(s, m.dt());
-        let (mut obs, checkpoints) = observers(s, total, &l.name);
+        let (mut obs, checkpoints) = observers(s, total)?;
+        obs.push(Box::new(Progress::new(total, 0, &l.name)));
         let cfg = LoopCfg {
             dir,
             key,

@@ -63,12 +63,23 @@ pub enum Trigger {
     AtTimes(Vec<f64>),
     /// Every so many seconds of wall-clock time.
     WallSeconds(f64),
+    /// At the step after the one at which `probe` crossed each of `crosses` (upwards).
+    When {
+        probe: Probe,
+        crosses: Vec<f64>,
+    },
     Never,
 }
 
 impl Trigger {
-    /// From the scene's `[output]` entry, for a run of `total` steps of `dt` seconds.
-    pub fn from_spec(t: &crate::scenes::schema::TriggerSpec, total: u64) -> Self {
+    /// From the scene's `[output]` entry, for a run of `total` steps; `probe` is the condition
+    /// of a `when` entry, resolved by the caller (it names walls).
+    pub fn from_spec(t: &crate::scenes::schema::TriggerSpec, total: u64, probe: Option<Probe>) -> Self {
+        if let (Some(w), Some(p)) = (&t.when, probe) {
+            let mut c = w.crosses.clone();
+            c.sort_by(f64::total_cmp);
+            return Trigger::When { probe: p, crosses: c };
+        }
         if let Some(n) = t.every {
             Trigger::Every(n.max(1))
         } else if let Some(c) = t.count {
@@ -91,7 +102,29 @@ impl Trigger {
             Trigger::Every(n) => step.is_multiple_of(*n),
             Trigger::AtTimes(ts) => ts.iter().any(|&t| prev_time < t && t <= time),
             Trigger::WallSeconds(s) => since >= *s,
-            Trigger::Never => false,
+            // Conditions are checked by the loop after each step (`Trigger::crossed`).
+            Trigger::When { .. } | Trigger::Never => false,
+        }
+    }
+}
+
+impl Trigger {
+    /// For a condition trigger: whether the probed quantity went from `before` to `now` across
+    /// one of its values.
+    pub fn crossed(&self, before: Option<f64>, now: Option<f64>) -> bool {
+        match (self, before, now) {
+            (Trigger::When { crosses, .. }, b, Some(n)) => {
+                let b = b.unwrap_or(f64::NEG_INFINITY);
+                crosses.iter().any(|&c| b < c && c <= n)
+            }
+            _ => false,
+        }
+    }
+
+    fn probe(&self) -> Option<Probe> {
+        match self {
+            Trigger::When { probe, .. } => Some(*probe),
+            _ => None,
         }
     }
 }
@@ -169,6 +202,9 @@ struct Checkpoint {
     step: u64,
     model: serde_json::Value,
     observers: Vec<(String, serde_json::Value)>,
+    /// Condition triggers that fired at the checkpoint's step and act at the next one.
+    #[serde(default)]
+    armed: Vec<bool>,
 }
 
 const FORMAT: u32 = 1;
@@ -191,11 +227,17 @@ pub struct LoopCfg<'a> {
 pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &LoopCfg) -> Result<Ending> {
     let t0 = Instant::now();
     let (dir, key, total) = (cfg.dir, cfg.key, cfg.total);
+    let mut armed = vec![false; observers.len()];
     let resumed_from = if cfg.resume {
-        Some(restore(model, observers, dir, key)?)
+        Some(restore(model, observers, &mut armed, dir, key)?)
     } else {
         None
     };
+    // Last value of each condition trigger's quantity (the run's state at the start counts).
+    let mut probed: Vec<Option<f64>> = observers
+        .iter()
+        .map(|o| o.trigger().probe().and_then(|p| model.probe(p)))
+        .collect();
     let mut last_fired: Vec<Instant> = vec![Instant::now(); observers.len()];
     let mut last_checkpoint = Instant::now();
     // A checkpoint or interruption asked for at a step where the model cannot be saved waits
@@ -211,8 +253,11 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
         let fire: Vec<bool> = observers
             .iter()
             .zip(&last_fired)
-            .map(|(o, lf)| {
-                o.trigger().fires(next, t, prev_t, lf.elapsed().as_secs_f64()) || (last && o.at_last_step())
+            .zip(&armed)
+            .map(|((o, lf), a)| {
+                o.trigger().fires(next, t, prev_t, lf.elapsed().as_secs_f64())
+                    || *a
+                    || (last && o.at_last_step())
             })
             .collect();
         let fields = observers.iter().zip(&fire).any(|(o, f)| *f && o.needs_fields());
@@ -226,6 +271,11 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
         };
         let mut flow = Flow::Continue;
         for (k, o) in observers.iter_mut().enumerate() {
+            if let Some(p) = o.trigger().probe() {
+                let now = model.probe(p);
+                armed[k] = o.trigger().crossed(probed[k], now);
+                probed[k] = now;
+            }
             if !fire[k] {
                 continue;
             }
@@ -254,7 +304,7 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
         if let Some(why) = &pending_interrupt
             && model.can_checkpoint()
         {
-            save(model, observers, dir, key)?;
+            save(model, observers, &armed, dir, key)?;
             return Err(crate::contract::Interrupted {
                 reason: why.clone(),
                 step,
@@ -266,7 +316,7 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
                 .checkpoints
                 .fires(step, t, prev_t, last_checkpoint.elapsed().as_secs_f64());
         if pending_checkpoint && model.can_checkpoint() {
-            save(model, observers, dir, key)?;
+            save(model, observers, &armed, dir, key)?;
             last_checkpoint = Instant::now();
             pending_checkpoint = false;
         }
@@ -291,7 +341,13 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
 }
 
 /// Write the checkpoint (atomically).
-pub fn save(model: &dyn Model, observers: &[Box<dyn Observer>], dir: &Path, key: &str) -> Result<()> {
+pub fn save(
+    model: &dyn Model,
+    observers: &[Box<dyn Observer>],
+    armed: &[bool],
+    dir: &Path,
+    key: &str,
+) -> Result<()> {
     let ck = Checkpoint {
         format: FORMAT,
         key: key.to_string(),
@@ -301,6 +357,7 @@ pub fn save(model: &dyn Model, observers: &[Box<dyn Observer>], dir: &Path, key:
             .iter()
             .map(|o| (o.name().to_string(), o.save()))
             .collect(),
+        armed: armed.to_vec(),
     };
     // JSON: self-describing (the engines' tagged enums need it) and exact for every f64.
     let bytes = serde_json::to_vec(&ck).context("cannot encode the checkpoint")?;
@@ -309,7 +366,13 @@ pub fn save(model: &dyn Model, observers: &[Box<dyn Observer>], dir: &Path, key:
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-fn restore(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], dir: &Path, key: &str) -> Result<u64> {
+fn restore(
+    model: &mut dyn Model,
+    observers: &mut [Box<dyn Observer>],
+    armed: &mut [bool],
+    dir: &Path,
+    key: &str,
+) -> Result<u64> {
     let path = dir.join(CHECKPOINT);
     let bytes = std::fs::read(&path).with_context(|| {
         format!(
@@ -343,6 +406,9 @@ fn restore(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], dir: &Pat
         if let Some((_, v)) = ck.observers.iter().find(|(n, _)| n == o.name()) {
             o.restore(v.clone())?;
         }
+    }
+    if ck.armed.len() == armed.len() {
+        armed.copy_from_slice(&ck.armed);
     }
     eprintln!("resuming at step {} from {}", ck.step, path.display());
     Ok(ck.step)

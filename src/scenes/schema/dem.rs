@@ -50,6 +50,9 @@ fn one() -> f64 {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct WallSection {
+    /// A name to refer to the wall by (stop conditions, triggers); plane and segment walls only.
+    #[serde(default)]
+    pub name: Option<String>,
     #[serde(default, rename = "box")]
     pub box_: Option<[f64; 4]>,
     #[serde(default)]

@@ -23,7 +23,7 @@ pub use fluid::{
     BoundariesSection, FaceSection, FluidSection, ForcingSection, LatticeSection, MaskSection,
     ObstacleSection,
 };
-pub use run::{OutputSection, RunSection, TriggerSpec, WallMoved};
+pub use run::{OutputSection, RunSection, TriggerSpec, WallMoved, WallRef, When};
 
 use anyhow::{Context, Result, bail};
 use lbdem_dem::Law;
@@ -351,15 +351,40 @@ fn check_trigger(what: &str, t: &TriggerSpec) -> Result<()> {
         + usize::from(t.count.is_some())
         + usize::from(t.at.is_some())
         + usize::from(t.wall_seconds.is_some())
+        + usize::from(t.when.is_some())
         + usize::from(t.never);
     if given != 1 {
         bail!(
             "[output] {what}: give exactly one of every = N (steps), count = N, at = [times in s], \
-             wall_seconds = S or never = true"
+             when = {{ quantity, crosses }}, wall_seconds = S or never = true"
         );
     }
     if t.every == Some(0) || t.count == Some(0) {
         bail!("[output] {what}: every / count must be at least 1 (use never = true to switch it off)");
+    }
+    if let Some(w) = &t.when {
+        match (w.quantity.as_str(), &w.wall) {
+            ("wall_displacement", Some(_)) | ("max_grain_speed" | "mean_liquid_speed", None) => {}
+            ("wall_displacement", None) => {
+                bail!("[output] {what}: when quantity = \"wall_displacement\" needs wall = index or name")
+            }
+            ("max_grain_speed" | "mean_liquid_speed", Some(_)) => {
+                bail!(
+                    "[output] {what}: when quantity = \"{}\" takes no wall",
+                    w.quantity
+                )
+            }
+            (q, _) => bail!(
+                "[output] {what}: when quantity = \"{q}\" is not known; use \"wall_displacement\", \
+                 \"max_grain_speed\" or \"mean_liquid_speed\""
+            ),
+        }
+        if w.crosses.is_empty() || w.crosses.iter().any(|c| !c.is_finite()) {
+            bail!(
+                "[output] {what}: when crosses = {:?}: give one or more finite values",
+                w.crosses
+            );
+        }
     }
     if let Some(s) = t.wall_seconds
         && !(s > 0.0 && s.is_finite())

@@ -31,13 +31,35 @@ pub struct RunSection {
     pub threads: usize,
 }
 
-/// `until_wall_moved = { wall = 0, distance = 1e-3 }`: wall index in `[[walls]]` order (a box
-/// counts as four walls: left, right, bottom, top).
-#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+/// `until_wall_moved = { wall = "plate", distance = 1e-3 }`: the wall by its `name` in
+/// `[[walls]]`, or by its index among the DEM walls (a box counts as four: left, right, bottom,
+/// top).
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct WallMoved {
-    pub wall: usize,
+    pub wall: WallRef,
     pub distance: f64,
+}
+
+/// A wall by index or by name.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum WallRef {
+    Index(usize),
+    Name(String),
+}
+
+/// A condition trigger: acts at the first step after `quantity` has crossed each of the values
+/// in `crosses` (ascending), e.g. snapshots at given push-plate displacements:
+/// `{ when = { quantity = "wall_displacement", wall = "plate", crosses = [1e-3, 2e-3] } }`.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct When {
+    /// "wall_displacement" (m, needs `wall`), "max_grain_speed" (m/s) or "mean_liquid_speed" (m/s).
+    pub quantity: String,
+    #[serde(default)]
+    pub wall: Option<WallRef>,
+    pub crosses: Vec<f64>,
 }
 
 /// `[output]`: when the series, snapshots and checkpoints are written.
@@ -94,8 +116,9 @@ fn threshold() -> f64 {
 }
 
 /// When an observer acts; exactly one key: `{ every = 100 }` steps, `{ count = 20 }` times
-/// spread evenly over the run, `{ at = [0.1, 0.2] }` simulated seconds, `{ wall_seconds = 600 }`
-/// of wall-clock time (checkpoints only), or `{ never = true }`.
+/// spread evenly over the run, `{ at = [0.1, 0.2] }` simulated seconds, `{ when = {...} }` a
+/// condition ([`When`]), `{ wall_seconds = 600 }` of wall-clock time (checkpoints only), or
+/// `{ never = true }`.
 #[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TriggerSpec {
@@ -105,6 +128,8 @@ pub struct TriggerSpec {
     pub count: Option<u64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub at: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub when: Option<When>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wall_seconds: Option<f64>,
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]

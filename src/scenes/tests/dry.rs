@@ -144,3 +144,50 @@ fn reads_digitised_circles_in_pixels() {
     let err = format!("{:#}", simulate(&text, t.path(), false).unwrap_err());
     assert!(err.contains("no column \"r\""), "{err}");
 }
+
+/// Condition triggers and a named wall: a push-plate (a segment named "plate") rises at a known
+/// speed; snapshots are taken at the step after it has moved 0.1 and 0.2 mm, and the run stops
+/// when it has moved 0.3 mm.
+#[test]
+fn snapshots_when_the_plate_has_moved_and_stop_at_a_distance() {
+    let t = tempfile::tempdir().unwrap();
+    let scene = SCENE
+        .replace(
+            "[[walls]]\nbox = [0.0, 0.0, 0.01, 0.01]",
+            "[[walls]]\nbox = [0.0, 0.0, 0.01, 0.01]\n[[walls]]\nname = \"plate\"\na = [0.003, 0.0005]\nb = [0.007, 0.0005]\nvelocity = [0.0, 0.05]",
+        )
+        .replace(
+            "snapshots = { every = 1000 }",
+            "snapshots = { when = { quantity = \"wall_displacement\", wall = \"plate\", crosses = [1e-4, 2e-4] } }",
+        )
+        .replace("steps = 3000", "steps = 3000\nuntil_wall_moved = { wall = \"plate\", distance = 3e-4 }");
+    let rec = simulate(&scene, t.path(), false).unwrap();
+    // The plate moves by v dt = 2e-7 m per step (accumulated as the stepper does).
+    let (mut y, y0, mut n, mut crossed) = (0.0005f64, 0.0005f64, 0u64, Vec::new());
+    let mut next = [1e-4, 2e-4, 3e-4].into_iter().peekable();
+    while let Some(&d) = next.peek() {
+        y += 0.05 * 4.0e-6;
+        n += 1;
+        if (y - y0).abs() >= d {
+            crossed.push(n);
+            next.next();
+        }
+    }
+    let stop = crossed[2];
+    assert_eq!(
+        rec.output.summary["steps"], stop,
+        "{}",
+        rec.output.summary["stopped"]
+    );
+    assert!(rec.output.summary["stopped"].as_str().unwrap().contains("moved"));
+    let index = crate::report::table::read_table(&t.path().join("out/snapshots.csv")).unwrap();
+    let p = t.path().join("out/snapshots.csv");
+    let steps = crate::report::table::u64_column(&index, "step", &p).unwrap();
+    let mut snap: Vec<u64> = steps.clone();
+    snap.dedup();
+    // one step after each crossing, and the state the run ended in
+    assert_eq!(snap, vec![crossed[0] + 1, crossed[1] + 1, stop], "{steps:?}");
+    let bad = scene.replace("wall = \"plate\", distance", "wall = \"plates\", distance");
+    let e = format!("{:#}", simulate(&bad, &t.path().join("bad"), false).unwrap_err());
+    assert!(e.contains("\"plates\"") && e.contains("plate"), "{e}");
+}
