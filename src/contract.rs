@@ -20,6 +20,9 @@ use std::path::{Path, PathBuf};
 /// The file name of a stage's manifest, in its output directory.
 pub const MANIFEST: &str = "stage.json";
 
+/// The file name of a resumable stage's checkpoint, in its working directory (`.partial`).
+pub const CHECKPOINT: &str = "checkpoint.json";
+
 /// The file name of a pipeline's provenance record, in its output directory.
 pub const PROVENANCE: &str = "provenance.json";
 

@@ -86,6 +86,9 @@ pub fn reusable(prepared: &Prepared, ctx: &StageContext) -> Result<Option<StageR
 /// so `lbdem run` can continue it instead of starting again.
 pub fn resumable(prepared: &Prepared, ctx: &StageContext) -> Result<bool> {
     let partial = ctx.out_dir.join(super::PARTIAL);
+    if !partial.join(crate::contract::CHECKPOINT).is_file() {
+        return Ok(false); // killed before its first checkpoint: nothing to continue
+    }
     let Ok(stored) = std::fs::read_to_string(partial.join(KEY_FILE)) else {
         return Ok(false);
     };

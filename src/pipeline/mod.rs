@@ -73,7 +73,8 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
             let stored = std::fs::read_to_string(&key_file).unwrap_or_default();
             if stored.trim() != key {
                 bail!(
-                    "--resume: the interrupted run in {} was made with other parameters, inputs or code                      (run key {}, now {key}); run without --resume to start again",
+                    "--resume: the interrupted run in {} was made with other parameters, inputs or code (run key {}, \
+                     now {key}); run without --resume to start again",
                     staging.display(),
                     stored.trim()
                 );
@@ -104,10 +105,24 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
 }
 
 /// Move everything from `staging` into `out` (but the run key of a resumable stage),
-/// replacing files and directories of the same name.
+/// replacing files and directories of the same name. The files an earlier run of the stage
+/// listed and this one did not write are removed first, and the manifest moves last, so a
+/// manifest never lists a file of another run.
 fn publish(staging: &Path, out: &Path) -> Result<()> {
-    for entry in std::fs::read_dir(staging)? {
-        let entry = entry?;
+    let old: Option<StageRecord> = std::fs::read_to_string(out.join(MANIFEST))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let _ = std::fs::remove_file(out.join(MANIFEST));
+    if let Some(old) = old {
+        for f in &old.output.files {
+            if !staging.join(f).exists() {
+                let _ = std::fs::remove_file(out.join(f));
+            }
+        }
+    }
+    let mut entries: Vec<_> = std::fs::read_dir(staging)?.collect::<Result<_, _>>()?;
+    entries.sort_by_key(|e| e.file_name() == MANIFEST);
+    for entry in entries {
         if entry.file_name() == cache::KEY_FILE {
             continue;
         }

@@ -2,7 +2,7 @@
 //! any change to inputs, parameters or outputs reruns them.
 
 use super::*;
-use crate::contract::{MANIFEST, StageContext, StageOutput};
+use crate::contract::{MANIFEST, StageContext, StageOutput, StageRecord};
 use crate::registry::Prepared;
 use std::path::PathBuf;
 
@@ -134,4 +134,42 @@ fn schema_rejects_duplicates_and_unknown_kinds() {
     let ok = "[pipeline]\nname='x'\nroot='..'\nout='reports/x'\n[[stage]]\nname='a'\nkind='report'\n";
     let pl = schema::Pipeline::parse(ok, p).unwrap();
     assert_eq!(pl.out_dir(), PathBuf::from("pipelines/../reports/x"));
+}
+
+/// A rerun that writes fewer files removes those of the earlier run (they would otherwise sit
+/// beside a manifest that does not list them), and leaves files it never owned alone.
+#[test]
+fn rerun_removes_the_earlier_runs_files_it_did_not_write_again() {
+    let (_d, input, ctx) = setup();
+    let stage = |names: &'static [&'static str]| {
+        Prepared::from_parts(
+            "test",
+            serde_json::json!({}),
+            vec![input.clone()],
+            move |c: &StageContext| {
+                for n in names {
+                    lbdem_core::atomic::write_atomic(&c.out_dir.join(n), b"x")?;
+                }
+                Ok(StageOutput {
+                    files: names.iter().map(PathBuf::from).collect(),
+                    ..Default::default()
+                })
+            },
+        )
+    };
+    execute(stage(&["a.txt", "b.txt"]), &ctx).unwrap();
+    std::fs::write(ctx.out_dir.join("notes.md"), b"mine").unwrap();
+    execute(stage(&["a.txt"]), &ctx).unwrap();
+    assert!(ctx.out_dir.join("a.txt").is_file());
+    assert!(
+        !ctx.out_dir.join("b.txt").exists(),
+        "a file of the earlier run stayed"
+    );
+    assert!(
+        ctx.out_dir.join("notes.md").is_file(),
+        "a file the stage never wrote was removed"
+    );
+    let rec: StageRecord =
+        serde_json::from_str(&std::fs::read_to_string(ctx.out_dir.join(MANIFEST)).unwrap()).unwrap();
+    assert_eq!(rec.output.files, vec![PathBuf::from("a.txt")]);
 }

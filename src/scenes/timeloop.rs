@@ -27,6 +27,10 @@ pub trait Model {
     fn sample(&self) -> Vec<f64>;
     /// A quantity the stop conditions read; `None` when the model has no such thing.
     fn probe(&self, q: Probe) -> Option<f64>;
+    /// Whether [`Model::probe`] of `q` reads the fields a step computes only when asked.
+    fn probe_needs_fields(&self, _q: Probe) -> bool {
+        false
+    }
     /// Write the current state under `dir` (tables that can be read back, VTK beside them);
     /// returns (kind, path relative to `dir`) of each file.
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>>;
@@ -193,7 +197,7 @@ pub struct Ending {
 }
 
 /// The checkpoint file in the run's directory.
-pub const CHECKPOINT: &str = "checkpoint.json";
+pub use crate::contract::CHECKPOINT;
 
 #[derive(Serialize, Deserialize)]
 struct Checkpoint {
@@ -202,9 +206,12 @@ struct Checkpoint {
     step: u64,
     model: serde_json::Value,
     observers: Vec<(String, serde_json::Value)>,
-    /// Condition triggers that fired at the checkpoint's step and act at the next one.
+    /// Condition triggers that fired at the checkpoint's step and act at the next one, and the
+    /// last value of each one's quantity.
     #[serde(default)]
     armed: Vec<bool>,
+    #[serde(default)]
+    probed: Vec<Option<f64>>,
 }
 
 const FORMAT: u32 = 1;
@@ -228,16 +235,20 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
     let t0 = Instant::now();
     let (dir, key, total) = (cfg.dir, cfg.key, cfg.total);
     let mut armed = vec![false; observers.len()];
-    let resumed_from = if cfg.resume {
-        Some(restore(model, observers, &mut armed, dir, key)?)
-    } else {
-        None
-    };
     // Last value of each condition trigger's quantity (the run's state at the start counts).
     let mut probed: Vec<Option<f64>> = observers
         .iter()
         .map(|o| o.trigger().probe().and_then(|p| model.probe(p)))
         .collect();
+    let resumed_from = if cfg.resume {
+        Some(restore(model, observers, &mut armed, &mut probed, dir, key)?)
+    } else {
+        None
+    };
+    // Condition triggers whose quantity needs the liquid's fields get them every step.
+    let condition_fields = observers
+        .iter()
+        .any(|o| o.trigger().probe().is_some_and(|p| model.probe_needs_fields(p)));
     let mut last_fired: Vec<Instant> = vec![Instant::now(); observers.len()];
     let mut last_checkpoint = Instant::now();
     // A checkpoint or interruption asked for at a step where the model cannot be saved waits
@@ -260,7 +271,7 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
                     || (last && o.at_last_step())
             })
             .collect();
-        let fields = observers.iter().zip(&fire).any(|(o, f)| *f && o.needs_fields());
+        let fields = condition_fields || observers.iter().zip(&fire).any(|(o, f)| *f && o.needs_fields());
         model.step(fields)?;
         step = model.steps_done();
         let cx = LoopCtx {
@@ -304,7 +315,7 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
         if let Some(why) = &pending_interrupt
             && model.can_checkpoint()
         {
-            save(model, observers, &armed, dir, key)?;
+            save(model, observers, &armed, &probed, dir, key)?;
             return Err(crate::contract::Interrupted {
                 reason: why.clone(),
                 step,
@@ -316,7 +327,7 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
                 .checkpoints
                 .fires(step, t, prev_t, last_checkpoint.elapsed().as_secs_f64());
         if pending_checkpoint && model.can_checkpoint() {
-            save(model, observers, &armed, dir, key)?;
+            save(model, observers, &armed, &probed, dir, key)?;
             last_checkpoint = Instant::now();
             pending_checkpoint = false;
         }
@@ -345,6 +356,7 @@ pub fn save(
     model: &dyn Model,
     observers: &[Box<dyn Observer>],
     armed: &[bool],
+    probed: &[Option<f64>],
     dir: &Path,
     key: &str,
 ) -> Result<()> {
@@ -358,8 +370,10 @@ pub fn save(
             .map(|o| (o.name().to_string(), o.save()))
             .collect(),
         armed: armed.to_vec(),
+        probed: probed.to_vec(),
     };
-    // JSON: self-describing (the engines' tagged enums need it) and exact for every f64.
+    // JSON: self-describing (the engines' tagged enums need it) and exact for every finite f64
+    // (NaN and infinities become null: states that can hold them say how they read it back).
     let bytes = serde_json::to_vec(&ck).context("cannot encode the checkpoint")?;
     let path = dir.join(CHECKPOINT);
     lbdem_core::atomic::write_atomic(&path, &bytes)
@@ -370,6 +384,7 @@ fn restore(
     model: &mut dyn Model,
     observers: &mut [Box<dyn Observer>],
     armed: &mut [bool],
+    probed: &mut [Option<f64>],
     dir: &Path,
     key: &str,
 ) -> Result<u64> {
@@ -407,8 +422,9 @@ fn restore(
             o.restore(v.clone())?;
         }
     }
-    if ck.armed.len() == armed.len() {
+    if ck.armed.len() == armed.len() && ck.probed.len() == probed.len() {
         armed.copy_from_slice(&ck.armed);
+        probed.copy_from_slice(&ck.probed);
     }
     eprintln!("resuming at step {} from {}", ck.step, path.display());
     Ok(ck.step)

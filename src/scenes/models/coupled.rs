@@ -299,10 +299,18 @@ impl<T: Real> Model for CoupledModel<T> {
         })
     }
     fn save(&self) -> Result<serde_json::Value> {
-        Ok(serde_json::to_value(self.run.state())?)
+        Ok(serde_json::json!({ "run": self.run.state(), "wall_start": self.wall_start }))
     }
     fn restore(&mut self, state: serde_json::Value) -> Result<()> {
-        self.run.restore(serde_json::from_value(state)?)?;
+        #[derive(serde::Deserialize)]
+        #[serde(bound = "")]
+        struct S<T: Real> {
+            run: lbdem_coupling::driver::CoupledState<T>,
+            wall_start: Vec<Vec2>,
+        }
+        let s: S<T> = serde_json::from_value(state)?;
+        self.run.restore(s.run)?;
+        self.wall_start = s.wall_start;
         Ok(())
     }
 }

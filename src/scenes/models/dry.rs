@@ -147,10 +147,19 @@ impl Model for Dry {
         })
     }
     fn save(&self) -> Result<serde_json::Value> {
-        Ok(serde_json::to_value(&self.sys)?)
+        Ok(serde_json::json!({ "system": self.sys, "wall_start": self.wall_start }))
     }
     fn restore(&mut self, state: serde_json::Value) -> Result<()> {
-        self.sys = serde_json::from_value(state)?;
+        #[derive(serde::Deserialize)]
+        struct S {
+            system: System,
+            wall_start: Vec<Vec2>,
+        }
+        let s: S = serde_json::from_value(state)?;
+        // Where the walls started is part of the state: a [compress] preparation moved them
+        // before the run, and a resumed run does not repeat it.
+        self.sys = s.system;
+        self.wall_start = s.wall_start;
         self.stepper = Stepper::new();
         Ok(())
     }

@@ -293,6 +293,9 @@ impl<L: Lattice, T: Real> Model for FluidModel<L, T> {
             _ => None,
         }
     }
+    fn probe_needs_fields(&self, q: Probe) -> bool {
+        q == Probe::MeanLiquidSpeed
+    }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {
         let m = self.fields()?;
         let u = &self.su.units;

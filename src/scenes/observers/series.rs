@@ -65,10 +65,24 @@ impl Observer for Series {
         write_table(&path, &table).with_context(|| format!("cannot write {}", path.display()))
     }
     fn save(&self) -> serde_json::Value {
+        // JSON has no NaN: a missing value is written as null and read back as NaN.
         serde_json::to_value(&self.state).unwrap_or_default()
     }
     fn restore(&mut self, v: serde_json::Value) -> Result<()> {
-        self.state = serde_json::from_value(v)?;
+        #[derive(Deserialize)]
+        struct Stored {
+            steps: Vec<u64>,
+            rows: Vec<Vec<Option<f64>>>,
+        }
+        let st: Stored = serde_json::from_value(v)?;
+        self.state = State {
+            steps: st.steps,
+            rows: st
+                .rows
+                .into_iter()
+                .map(|r| r.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+                .collect(),
+        };
         Ok(())
     }
     fn report(&self, m: &dyn Model) -> (Vec<std::path::PathBuf>, Option<(&'static str, serde_json::Value)>) {

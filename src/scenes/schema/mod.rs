@@ -337,6 +337,33 @@ impl Scene {
         ] {
             check_trigger(what, t)?;
         }
+        if self.output.checkpoints.when.is_some() {
+            bail!(
+                "[output] checkpoints: when = {{...}} is for series and snapshots; use every, count, at or wall_seconds"
+            );
+        }
+        for (what, t) in [
+            ("series", &self.output.series),
+            ("snapshots", &self.output.snapshots),
+        ] {
+            if let Some(w) = &t.when {
+                let ok = match w.quantity.as_str() {
+                    "mean_liquid_speed" => liquid,
+                    _ => grains,
+                };
+                if !ok {
+                    bail!(
+                        "[output] {what}: when quantity = \"{}\" needs {} in the scene",
+                        w.quantity,
+                        if grains {
+                            "a liquid ([fluid])"
+                        } else {
+                            "grains ([particles])"
+                        }
+                    );
+                }
+            }
+        }
         if self.output.series.wall_seconds.is_some() || self.output.snapshots.wall_seconds.is_some() {
             bail!(
                 "[output]: wall_seconds is for checkpoints only (series and snapshots must not depend on the machine's speed)"

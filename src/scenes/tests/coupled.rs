@@ -171,7 +171,13 @@ fn interrupted_coupled_run_resumes_bitwise() {
     let dir = t.path().join("cut");
     let mut resume = false;
     let mut interruptions = 0;
-    while simulate(&limited, &dir, resume).is_err() {
+    while let Err(e) = simulate(&limited, &dir, resume) {
+        let msg = format!("{e:#}");
+        assert!(msg.contains("--resume"), "{msg}");
+        assert!(
+            dir.join("out/.partial/checkpoint.json").is_file(),
+            "no checkpoint kept: {msg}"
+        );
         interruptions += 1;
         resume = true;
         assert!(interruptions < 90, "never finished");

@@ -103,7 +103,13 @@ fn interrupted_liquid_resumes_bitwise() {
     let dir = t.path().join("cut");
     let mut resume = false;
     let mut interruptions = 0;
-    while simulate(&limited, &dir, resume).is_err() {
+    while let Err(e) = simulate(&limited, &dir, resume) {
+        let msg = format!("{e:#}");
+        assert!(msg.contains("--resume"), "{msg}");
+        assert!(
+            dir.join("out/.partial/checkpoint.json").is_file(),
+            "no checkpoint kept: {msg}"
+        );
         interruptions += 1;
         resume = true;
         assert!(interruptions < 3001, "never finished");
@@ -114,4 +120,44 @@ fn interrupted_liquid_resumes_bitwise() {
         let b = std::fs::read(dir.join("out").join(f)).unwrap();
         assert!(a == b, "{f} differs after {interruptions} interruptions");
     }
+}
+
+/// A condition on the liquid: a snapshot at the step after the mean speed first reaches half
+/// its steady value (the fields are computed every step for it).
+#[test]
+fn snapshot_when_the_mean_speed_crosses_a_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let half = 0.5 * 0.05 * 1e-6 / (12.0 * 1e-6);
+    let s = POISEUILLE
+        .replace("time = 3.0\nuntil_steady = 1e-9", "time = 1.0")
+        .replace(
+            "snapshots = { count = 2 }",
+            &format!("snapshots = {{ when = {{ quantity = \"mean_liquid_speed\", crosses = [{half:e}] }} }}"),
+        );
+    let rec = simulate(&s, dir.path(), false).unwrap();
+    let out = dir.path().join("out");
+    let p = out.join("snapshots.csv");
+    let index = crate::report::table::read_table(&p).unwrap();
+    let mut steps = crate::report::table::u64_column(&index, "step", &p).unwrap();
+    steps.dedup();
+    let last = rec.output.summary["steps"].as_u64().unwrap();
+    assert_eq!(steps.len(), 2, "{steps:?}");
+    assert_eq!(steps[1], last);
+    let mean = |step: u64| {
+        let fl =
+            crate::scenes::snapshot::read_fluid(&out.join(format!("snapshots/fluid_{step:09}.csv"))).unwrap();
+        fl.ux.iter().sum::<f64>() / fl.ux.len() as f64
+    };
+    let at = mean(steps[0]);
+    // The step after the crossing: above the value, by at most two steps' growth.
+    assert!(at >= half && at < 1.05 * half, "{at} vs {half}");
+    let bad = POISEUILLE.replace(
+        "snapshots = { count = 2 }",
+        "snapshots = { when = { quantity = \"max_grain_speed\", crosses = [1.0] } }",
+    );
+    let e = format!(
+        "{:#}",
+        simulate(&bad, &dir.path().join("bad"), false).unwrap_err()
+    );
+    assert!(e.contains("max_grain_speed") && e.contains("[particles]"), "{e}");
 }
