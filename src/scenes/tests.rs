@@ -23,6 +23,30 @@ fn simulate_to(text: &str, dir: &Path, out: &Path, resume: bool) -> anyhow::Resu
     crate::pipeline::execute(prepared, &ctx)
 }
 
+/// Run `text` (which sets a `[run] wall_clock` limit) again and again, resuming, until it
+/// finishes; every stop must be an interruption that kept its checkpoint. Returns how many
+/// interruptions there were (at least one, or the test proves nothing).
+fn resume_until_done(text: &str, dir: &Path, max: usize) -> usize {
+    let mut resume = false;
+    let mut interruptions = 0;
+    while let Err(e) = simulate(text, dir, resume) {
+        let msg = format!("{e:#}");
+        assert!(msg.contains("--resume"), "{msg}");
+        assert!(
+            dir.join("out/.partial/checkpoint.json").is_file(),
+            "no checkpoint kept: {msg}"
+        );
+        interruptions += 1;
+        resume = true;
+        assert!(interruptions < max, "never finished");
+    }
+    assert!(
+        interruptions >= 1,
+        "the wall-clock limit never interrupted the run"
+    );
+    interruptions
+}
+
 /// Every file under `dir`.
 fn walk(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();

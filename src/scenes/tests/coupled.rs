@@ -169,20 +169,7 @@ fn interrupted_coupled_run_resumes_bitwise() {
     simulate(&s, &t.path().join("whole"), false).unwrap();
     let limited = s.replace("steps = 90", "steps = 90\nwall_clock = 0.05");
     let dir = t.path().join("cut");
-    let mut resume = false;
-    let mut interruptions = 0;
-    while let Err(e) = simulate(&limited, &dir, resume) {
-        let msg = format!("{e:#}");
-        assert!(msg.contains("--resume"), "{msg}");
-        assert!(
-            dir.join("out/.partial/checkpoint.json").is_file(),
-            "no checkpoint kept: {msg}"
-        );
-        interruptions += 1;
-        resume = true;
-        assert!(interruptions < 90, "never finished");
-    }
-    assert!(interruptions >= 1);
+    let interruptions = resume_until_done(&limited, &dir, 90);
     for f in [
         "series.csv",
         "snapshots/fluid_000000090.csv",

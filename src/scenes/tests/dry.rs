@@ -45,28 +45,7 @@ fn interrupted_and_resumed_run_matches_uninterrupted_bitwise() {
     assert_eq!(whole.output.summary["steps"], 3000);
     let limited = SCENE.replace("steps = 3000", "steps = 3000\nwall_clock = 0.01");
     let dir = t.path().join("cut");
-    let mut resume = false;
-    let mut interruptions = 0;
-    loop {
-        match simulate(&limited, &dir, resume) {
-            Ok(_) => break,
-            Err(e) => {
-                let msg = format!("{e:#}");
-                assert!(msg.contains("--resume"), "{msg}");
-                assert!(
-                    dir.join("out/.partial/checkpoint.json").is_file(),
-                    "no checkpoint kept: {msg}"
-                );
-                interruptions += 1;
-                resume = true;
-                assert!(interruptions < 3000, "never finished");
-            }
-        }
-    }
-    assert!(
-        interruptions >= 1,
-        "the wall-clock limit never interrupted the run"
-    );
+    let interruptions = resume_until_done(&limited, &dir, 3000);
     let (a, b) = (t.path().join("whole/out"), dir.join("out"));
     for f in
         ["series.csv", "snapshots.csv"]

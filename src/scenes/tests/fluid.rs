@@ -101,20 +101,7 @@ fn interrupted_liquid_resumes_bitwise() {
     simulate(&s, &t.path().join("whole"), false).unwrap();
     let limited = s.replace("steps = 3001", "steps = 3001\nwall_clock = 0.005");
     let dir = t.path().join("cut");
-    let mut resume = false;
-    let mut interruptions = 0;
-    while let Err(e) = simulate(&limited, &dir, resume) {
-        let msg = format!("{e:#}");
-        assert!(msg.contains("--resume"), "{msg}");
-        assert!(
-            dir.join("out/.partial/checkpoint.json").is_file(),
-            "no checkpoint kept: {msg}"
-        );
-        interruptions += 1;
-        resume = true;
-        assert!(interruptions < 3001, "never finished");
-    }
-    assert!(interruptions >= 1);
+    let interruptions = resume_until_done(&limited, &dir, 3001);
     for f in ["series.csv", "snapshots/fluid_000003001.csv"] {
         let a = std::fs::read(t.path().join("whole/out").join(f)).unwrap();
         let b = std::fs::read(dir.join("out").join(f)).unwrap();
