@@ -92,14 +92,15 @@ impl ParticleTable {
     }
 }
 
-/// Write the particle and contact tables and the VTK points of `sys` at its current step
-/// under `dir/snapshots/`; returns (kind, path relative to `dir`).
+/// Write the particle and contact tables and the VTK points of `sys` under `dir/snapshots/`,
+/// named by the scene's `step` (a coupled scene counts LBM steps, the DEM its sub-steps);
+/// returns (kind, path relative to `dir`).
 pub fn write_particles(
     dir: &Path,
+    step: u64,
     sys: &System,
     contacts: &[ContactForce],
 ) -> Result<Vec<(&'static str, PathBuf)>> {
-    let step = sys.step;
     let t = ParticleTable::of(sys);
     let rel = |kind: &str, ext: &str| PathBuf::from(format!("snapshots/{kind}_{step:09}.{ext}"));
     let p = rel("particles", "csv");

@@ -163,6 +163,25 @@ impl<T: Real> CoupledModel<T> {
             .collect()
     }
 
+    /// Mean liquid speed over the active nodes (m/s) and the largest speed in lattice units
+    /// (for the Mach number, Su Eq. 16).
+    fn liquid_speeds(&self) -> (f64, f64) {
+        let run = &self.run;
+        let [nx, ny] = run.fluid.size();
+        let vscale = run.units.dx() / run.units.dt();
+        let (mut speed_sum, mut n_active, mut max_u) = (0.0, 0usize, 0.0f64);
+        for i in 0..nx * ny {
+            let (rho, v) = run.fluid.node(i);
+            if rho.is_finite() {
+                let s = (v[0] * v[0] + v[1] * v[1]).sqrt();
+                speed_sum += s;
+                max_u = max_u.max(s);
+                n_active += 1;
+            }
+        }
+        (speed_sum / n_active.max(1) as f64 * vscale, max_u)
+    }
+
     pub fn lattice_size(&self) -> [usize; 2] {
         [self.su.n[0], self.su.n[1]]
     }
@@ -204,19 +223,8 @@ impl<T: Real> Model for CoupledModel<T> {
     }
     fn sample(&self) -> Vec<f64> {
         let run = &self.run;
-        let [nx, ny] = run.fluid.size();
         let u = &run.units;
-        let vscale = u.dx() / u.dt();
-        let (mut speed_sum, mut n_active, mut max_u) = (0.0, 0usize, 0.0f64);
-        for i in 0..nx * ny {
-            let (rho, v) = run.fluid.node(i);
-            if rho.is_finite() {
-                let s = (v[0] * v[0] + v[1] * v[1]).sqrt();
-                speed_sum += s;
-                max_u = max_u.max(s);
-                n_active += 1;
-            }
-        }
+        let (mean_speed, max_u) = self.liquid_speeds();
         let dp = self.pressure_change();
         let (lo, hi) = crate::report::plot::finite_range(dp.iter().copied()).unwrap_or((0.0, 0.0));
         let below = dp.iter().filter(|&&p| p < self.threshold).count() as f64 * u.dx() * u.dx();
@@ -227,7 +235,7 @@ impl<T: Real> Model for CoupledModel<T> {
         let mom = run.momentum();
         let mut v = grain_sample(&run.sys, run.dem_stepper());
         v.extend([
-            speed_sum / n_active.max(1) as f64 * vscale,
+            mean_speed,
             max_u * 3f64.sqrt(),
             lo,
             hi,
@@ -246,7 +254,7 @@ impl<T: Real> Model for CoupledModel<T> {
                 let w = self.run.sys.walls.get(k)?;
                 Some((wall_anchor(w) - self.wall_start[k]).norm())
             }
-            Probe::MeanLiquidSpeed => Some(self.sample()[self.series_columns().len() - 9]),
+            Probe::MeanLiquidSpeed => Some(self.liquid_speeds().0),
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {
@@ -278,11 +286,10 @@ impl<T: Real> Model for CoupledModel<T> {
         };
         let mut out = write_fluid(dir, self.steps_done(), &f)?;
         // The particle files carry the LBM step in their name too, so one step's files sort together.
-        let mut sys = run.sys.clone();
-        sys.step = self.steps_done();
         out.extend(write_particles(
             dir,
-            &sys,
+            self.steps_done(),
+            &run.sys,
             &contact_list(run.dem_stepper(), &run.sys),
         )?);
         Ok(out)

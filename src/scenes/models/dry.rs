@@ -138,7 +138,12 @@ impl Model for Dry {
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {
-        write_particles(dir, &self.sys, &contact_list(&self.stepper, &self.sys))
+        write_particles(
+            dir,
+            self.sys.step,
+            &self.sys,
+            &contact_list(&self.stepper, &self.sys),
+        )
     }
     fn describe(&self) -> serde_json::Value {
         serde_json::json!({
