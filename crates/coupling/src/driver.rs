@@ -5,6 +5,7 @@
 //! first half-kick of velocity Verlet already uses it: the impulse the grains receive over the
 //! sub-cycles is exactly F δt, the momentum the fluid lost in the LBM step.
 
+use crate::confine::Confinement;
 use crate::error::CouplingError;
 use crate::hydro::{Hydro, HydroState};
 use crate::psm::{GrainMotion, Load};
@@ -66,6 +67,8 @@ pub struct Coupled<T: Real> {
     /// (see [`Coupled::with_interior_liquid_correction`]). Off by default.
     interior_liquid_correction: bool,
     pub timing: Timing,
+    /// The liquid confined to the sample (membrane and push-plates), if set.
+    confine: Option<Confinement>,
     /// Grain motions (lattice units) at the start of the previous LBM cycle.
     previous: Vec<GrainMotion>,
     dem: Stepper,
@@ -122,6 +125,7 @@ impl<T: Real> Coupled<T> {
             previous: Vec::new(),
             sys,
             timing: Timing::default(),
+            confine: None,
             dem: Stepper::new(),
             motions: Vec::new(),
             circles: Vec::new(),
@@ -157,6 +161,21 @@ impl<T: Real> Coupled<T> {
         }
         let periodic = self.sys.domain.periodic;
         self.fluid.map(&self.circles, &self.motions, self.r_hd, periodic)
+    }
+
+    /// Confine the liquid to the membrane minus the regions behind the walls `plates` (Su et
+    /// al. 2020 Fig. 2 step 15), from now on and before every LBM step. PSM only. The nodes
+    /// outside close at once; their liquid is not counted in [`crate::ZoneMass`].
+    pub fn with_confinement(mut self, plates: Vec<usize>) -> Result<Self, CouplingError> {
+        let mut c = Confinement::new(&self.sys, plates)?;
+        let [nx, ny] = self.fluid.size();
+        let (zone, vel) = c.zone(&self.sys, &self.units, nx, ny);
+        self.fluid.set_zone(zone, vel)?;
+        if let Hydro::Psm { fluid, .. } = &mut self.fluid {
+            fluid.reset_zone_mass();
+        }
+        self.confine = Some(c);
+        Ok(self)
     }
 
     /// Switch on the interior-liquid correction (PSM only; refused where it cannot be stable).
@@ -205,6 +224,11 @@ impl<T: Real> Coupled<T> {
     pub fn step(&mut self) -> Result<(), CouplingError> {
         let t0 = Instant::now();
         self.map_grains()?;
+        if let Some(c) = &mut self.confine {
+            let [nx, ny] = self.fluid.size();
+            let (zone, vel) = c.zone(&self.sys, &self.units, nx, ny);
+            self.fluid.set_zone(zone, vel)?;
+        }
         let t1 = Instant::now();
         self.fluid.step(&self.motions, &mut self.loads)?;
         let t2 = Instant::now();

@@ -4,7 +4,7 @@
 
 use crate::bounce::{BounceFluid, BounceState};
 use crate::error::CouplingError;
-use crate::psm::{GrainMotion, Load, PsmFluid, PsmState};
+use crate::psm::{GrainMotion, Load, PsmFluid, PsmState, ZoneMass};
 use crate::solid_fraction::{GrainCircle, SolidMap, solid_map};
 use lbdem_lbm::Real;
 use lbdem_lbm::lattice::CS2;
@@ -139,6 +139,26 @@ impl<T: Real> Hydro<T> {
             o.polar += w * (r[0] * r[0] + r[1] * r[1]);
         }
         Some(out)
+    }
+
+    /// Lay the solid zone over the lattice (PSM only, see [`PsmFluid::set_zone`]).
+    pub fn set_zone(&mut self, zone: &[u32], velocities: &[[f64; 3]]) -> Result<(), CouplingError> {
+        match self {
+            Hydro::Psm { fluid, .. } => fluid.set_zone(zone, velocities),
+            Hydro::BounceBack(_) => Err(CouplingError::Unsupported(
+                "a liquid confined to a deforming sample (membrane, push-plate) is built for \
+                 method = \"psm\" only; use it"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The liquid mass the solid zone removed and added so far (zero without one).
+    pub fn zone_mass(&self) -> ZoneMass {
+        match self {
+            Hydro::Psm { fluid, .. } => fluid.zone_mass(),
+            Hydro::BounceBack(_) => ZoneMass::default(),
+        }
     }
 
     /// One LBM step; the load on each grain in lattice units.

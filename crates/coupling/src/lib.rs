@@ -6,6 +6,7 @@
 //!   solid fraction of clumped grains with the hydrodynamic radius r_hd ([`solid_fraction`]);
 //! - the weighting B of Eq. 10 ([`weighting`]);
 //! - the PSM lattice: collision of Eqs. 9 and 11, force and moment of Eq. 14 ([`psm`]);
+//! - the liquid confined to a deforming sample, the moving "solid zone" ([`confine`]);
 //! - the sub-cycling driver that holds the hydrodynamic load over the DEM steps ([`driver`]).
 
 // Kernels index several parallel arrays (velocities, weights, populations) by direction: an index
@@ -14,6 +15,7 @@
 
 pub mod bounce;
 pub mod cases;
+pub mod confine;
 pub mod driver;
 pub mod error;
 pub mod hydro;
@@ -30,4 +32,5 @@ pub use bounce::{BounceFluid, BounceState};
 pub use driver::{Coupled, CoupledState};
 pub use error::CouplingError;
 pub use hydro::{Hydro, HydroState, Method};
-pub use psm::{GrainMotion, Load, PsmFluid, PsmSettings, PsmState};
+pub use confine::Confinement;
+pub use psm::{GrainMotion, LIQUID, Load, PsmFluid, PsmSettings, PsmState, ZoneMass};

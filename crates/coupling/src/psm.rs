@@ -88,8 +88,19 @@ pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
     src: Vec<u32>,
     /// Wall velocities (index 0: stationary inactive nodes; 1 + face for box walls).
     wall_u: Vec<[f64; 3]>,
-    /// Inactive nodes (outside the sample: the "solid zone" of Su Sect. 2.4) are never updated.
+    /// Inactive nodes (the domain's solid nodes, and the "solid zone" of Su Fig. 2 step 15 set
+    /// by [`PsmFluid::set_zone`]) are never updated; their links bounce back.
     active: Vec<bool>,
+    /// The domain's own node kinds and faces (the zone is laid over them).
+    domain: Domain,
+    base_active: Vec<bool>,
+    /// Per node: [`LIQUID`] or the index of the boundary velocity its solid zone shows.
+    zone: Vec<u32>,
+    /// First `wall_u` index of the zone's velocities (after the stationary entry and the faces).
+    zone_base: usize,
+    /// Liquid mass (lattice units) dropped by nodes the zone closed and added by nodes it opened,
+    /// since the start.
+    zone_mass: ZoneMass,
     settings: PsmSettings,
     /// Uniform collision constants (f64: every update is computed in f64).
     params: CollideParams<f64>,
@@ -118,6 +129,27 @@ pub struct PsmState<T: Real> {
     pub u: Vec<[f64; 3]>,
     pub local_tau: Option<Vec<f64>>,
     pub step: u64,
+    /// The solid zone and its velocities ([`PsmFluid::set_zone`]); empty if never set.
+    #[serde(default)]
+    pub zone: Vec<u32>,
+    #[serde(default)]
+    pub zone_velocities: Vec<[f64; 3]>,
+    #[serde(default)]
+    pub zone_mass: ZoneMass,
+}
+
+/// A node of the liquid in [`PsmFluid::set_zone`].
+pub const LIQUID: u32 = u32::MAX;
+
+/// Liquid mass (lattice units) that the moving solid zone took out of the lattice (nodes it
+/// closed) and put in (nodes it opened, refilled at the local density), since the start.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ZoneMass {
+    pub removed: f64,
+    pub added: f64,
+    /// Nodes closed and opened.
+    pub closed: u64,
+    pub opened: u64,
 }
 
 /// Equilibrium (Su Eq. 7, Leonardi Eq. 13).
@@ -183,16 +215,12 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             .iter()
             .map(|&k| k == lbdem_lbm::domain::FLUID)
             .collect();
+        let zone_base = wall_u.len();
         let mut src = vec![0u32; n * q];
+        let zone = vec![LIQUID; n];
         for idx in 0..n {
-            let p = domain.coords(idx);
             for i in 0..q {
-                let c = L::C[i];
-                src[idx * q + i] = match neighbour(domain, p, [-c[0], -c[1], -c[2]]) {
-                    Upstream::Node(j) if active[j] => j as u32,
-                    Upstream::Node(_) => WALL,
-                    Upstream::Face(f) => WALL | (1 + f as u32),
-                };
+                src[idx * q + i] = link::<L>(domain, &active, &active, &zone, zone_base, idx, i);
             }
         }
         let mut f = vec![T::default(); n * q];
@@ -209,7 +237,12 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             f,
             src,
             wall_u,
+            base_active: active.clone(),
             active,
+            domain: domain.clone(),
+            zone,
+            zone_base,
+            zone_mass: ZoneMass::default(),
             settings,
             params,
             local: None,
@@ -277,6 +310,9 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             u: self.u.clone(),
             local_tau: self.local.as_ref().map(|(_, t)| t.clone()),
             step: self.step,
+            zone: if self.zone_is_set() { self.zone.clone() } else { Vec::new() },
+            zone_velocities: self.wall_u[self.zone_base..].to_vec(),
+            zone_mass: self.zone_mass,
         }
     }
 
@@ -297,11 +333,156 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             Some(t) => self.set_local_tau(t)?,
             None => self.clear_local_tau(),
         }
+        if !state.zone.is_empty() && state.zone.len() != n {
+            return Err(CouplingError::Unsupported(format!(
+                "PSM state with a solid zone of {} nodes for a lattice of {n} nodes: the file is \
+                 inconsistent; write it again",
+                state.zone.len()
+            )));
+        }
         self.f = state.f;
         self.rho = state.rho;
         self.u = state.u;
         self.step = state.step;
+        self.zone_mass = state.zone_mass;
+        self.wall_u.truncate(self.zone_base);
+        self.wall_u.extend(state.zone_velocities);
+        self.zone = if state.zone.is_empty() { vec![LIQUID; n] } else { state.zone };
+        for idx in 0..n {
+            self.active[idx] = self.base_active[idx] && self.zone[idx] == LIQUID;
+        }
+        for idx in 0..n {
+            for i in 0..L::Q {
+                self.src[idx * L::Q + i] = link::<L>(
+                    &self.domain,
+                    &self.active,
+                    &self.base_active,
+                    &self.zone,
+                    self.zone_base,
+                    idx,
+                    i,
+                );
+            }
+        }
         Ok(())
+    }
+
+    fn zone_is_set(&self) -> bool {
+        self.zone.iter().any(|&z| z != LIQUID)
+    }
+
+    /// Lay a solid zone over the lattice (Su et al. 2020 Fig. 2, step 15): nodes with
+    /// `zone[x] == LIQUID` hold liquid, the others are solid and show the liquid the boundary
+    /// velocity `velocities[zone[x]]` (lattice units; the moving-wall bounce-back of the box
+    /// faces). Called before every LBM step as the sample deforms: only the nodes whose zone
+    /// changed are relinked.
+    ///
+    /// A node that closes loses its liquid (counted in [`ZoneMass::removed`]); a node that opens
+    /// is refilled with the equilibrium at the mean density of its liquid neighbours and the
+    /// velocity of the boundary that uncovered it (counted in [`ZoneMass::added`]), the
+    /// refilling rule of moving bounce-back (Leonardi et al. 2014 Eq. 21).
+    pub fn set_zone(&mut self, zone: &[u32], velocities: &[[f64; 3]]) -> Result<(), CouplingError> {
+        let n = self.nodes();
+        let q = L::Q;
+        if zone.len() != n {
+            return Err(CouplingError::Unsupported(format!(
+                "solid zone of {} nodes for a lattice of {n} nodes",
+                zone.len()
+            )));
+        }
+        if let Some(&z) = zone.iter().find(|&&z| z != LIQUID && z as usize >= velocities.len()) {
+            return Err(CouplingError::Unsupported(format!(
+                "solid zone refers to boundary velocity {z} of {}",
+                velocities.len()
+            )));
+        }
+        self.wall_u.truncate(self.zone_base);
+        self.wall_u.extend_from_slice(velocities);
+        let mut changed = Vec::new();
+        let mut opened = Vec::new();
+        for idx in 0..n {
+            if zone[idx] == self.zone[idx] || !self.base_active[idx] {
+                continue;
+            }
+            changed.push(idx);
+            if self.zone[idx] == LIQUID {
+                let m: f64 = self.f[idx * q..(idx + 1) * q].iter().map(|v| v.to_f64()).sum();
+                self.zone_mass.removed += m;
+                self.zone_mass.closed += 1;
+                self.active[idx] = false;
+            } else if zone[idx] == LIQUID {
+                opened.push((idx, self.zone[idx]));
+            }
+        }
+        // Refill from the liquid that was there before this call (not from nodes opening now).
+        let was_active = self.active.clone();
+        for &(idx, from) in &opened {
+            let p = self.domain.coords(idx);
+            let (mut sum, mut count) = (0.0, 0usize);
+            for i in 1..q {
+                let c = L::C[i];
+                if let Upstream::Node(j) = neighbour(&self.domain, p, [c[0], c[1], c[2]])
+                    && was_active[j]
+                {
+                    sum += self.rho[j];
+                    count += 1;
+                }
+            }
+            let rho = if count > 0 { sum / count as f64 } else { 1.0 };
+            let u = self.wall_u[self.zone_base + from as usize];
+            let usq = norm2::<L>(u);
+            for i in 0..q {
+                self.f[idx * q + i] = T::from_f64(feq::<L>(i, rho, u, usq));
+            }
+            self.rho[idx] = rho;
+            self.u[idx] = u;
+            self.zone_mass.added += rho;
+            self.zone_mass.opened += 1;
+        }
+        for &(idx, _) in &opened {
+            self.active[idx] = true;
+        }
+        for &idx in &changed {
+            self.zone[idx] = zone[idx];
+        }
+        // Relink each changed node and the nodes that pull from it.
+        for &idx in &changed {
+            let p = self.domain.coords(idx);
+            for i in 0..q {
+                self.src[idx * q + i] = link::<L>(
+                    &self.domain,
+                    &self.active,
+                    &self.base_active,
+                    &self.zone,
+                    self.zone_base,
+                    idx,
+                    i,
+                );
+                let c = L::C[i];
+                if let Upstream::Node(x) = neighbour(&self.domain, p, [c[0], c[1], c[2]]) {
+                    self.src[x * q + i] = link::<L>(
+                        &self.domain,
+                        &self.active,
+                        &self.base_active,
+                        &self.zone,
+                        self.zone_base,
+                        x,
+                        i,
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Start counting [`ZoneMass`] afresh (after laying the first zone).
+    pub fn reset_zone_mass(&mut self) {
+        self.zone_mass = ZoneMass::default();
+    }
+
+    /// The liquid mass the solid zone removed and added so far ([`PsmFluid::set_zone`]).
+    pub fn zone_mass(&self) -> ZoneMass {
+        self.zone_mass
     }
 
     /// Nodes of the lattice.
@@ -513,6 +694,27 @@ impl<T: Real> PsmFluid<T, D2Q9> {
         self.motions = motions;
         self.loads3 = loads3;
         r
+    }
+}
+
+/// The pull source of population `i` at node `idx`: the upstream node if it holds liquid, else
+/// a bounce-back link to what is there: a box face, the domain's stationary solid, or the solid
+/// zone with its boundary velocity.
+fn link<L: Lattice>(
+    domain: &Domain,
+    active: &[bool],
+    base_active: &[bool],
+    zone: &[u32],
+    zone_base: usize,
+    idx: usize,
+    i: usize,
+) -> u32 {
+    let c = L::C[i];
+    match neighbour(domain, domain.coords(idx), [-c[0], -c[1], -c[2]]) {
+        Upstream::Node(j) if active[j] => j as u32,
+        Upstream::Node(j) if base_active[j] && zone[j] != LIQUID => WALL | (zone_base as u32 + zone[j]),
+        Upstream::Node(_) => WALL,
+        Upstream::Face(f) => WALL | (1 + f as u32),
     }
 }
 

@@ -16,6 +16,7 @@ mod kick_disks;
 mod lanes;
 pub mod neighbor;
 mod pair_linear;
+pub mod polygon;
 mod scratch;
 pub mod shape;
 pub mod stepper;
