@@ -70,3 +70,4 @@ mod coupled;
 mod dry;
 mod fluid;
 mod schema;
+mod shear_cell;

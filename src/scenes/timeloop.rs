@@ -34,6 +34,11 @@ pub trait Model {
     /// Write the current state under `dir` (tables that can be read back, VTK beside them);
     /// returns (kind, path relative to `dir`) of each file.
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>>;
+    /// A short note on where the run stands, beside the progress bar (e.g. the push-plate's
+    /// displacement in grain diameters).
+    fn progress_note(&self) -> Option<String> {
+        None
+    }
     /// What the run was (engine settings, timings) for the summary.
     fn describe(&self) -> serde_json::Value {
         serde_json::Value::Null

@@ -5,15 +5,17 @@
 //!
 //! The membrane boundary is the polygon joining the centroids of the membrane grains (the one of
 //! Eq. 18); a push-plate's solid region is the quadrilateral behind its segment
-//! (`lbdem_dem::polygon::plate_region`). Nodes outside the polygon show the liquid a wall at
-//! rest; nodes behind a plate show it the plate's velocity.
+//! (`lbdem_dem::polygon::plate_region`). Nodes behind a plate show the liquid the plate's
+//! velocity; nodes outside the polygon next to the liquid show it the velocity of the nearest
+//! membrane grain, so that a membrane pushed inward compresses the liquid instead of eating
+//! it while appearing to stand still (which sucks the liquid away from the grains that move).
 
 use crate::error::CouplingError;
 use crate::psm::LIQUID;
 use crate::units::CouplingUnits;
 use lbdem_dem::System;
-use lbdem_dem::Vec2;
 use lbdem_dem::polygon::{plate_region, scan_rows};
+use lbdem_dem::{Vec2, Vector};
 
 /// Which nodes hold liquid, recomputed from the grains and walls.
 #[derive(Clone, Debug)]
@@ -60,9 +62,16 @@ impl Confinement {
     }
 
     /// The solid zone of an `nx` × `ny` lattice for the present grains and walls, and the
-    /// boundary velocities it refers to (lattice units): 0 at rest outside the membrane,
-    /// 1 + k behind plate k.
-    pub fn zone(&mut self, sys: &System, units: &CouplingUnits, nx: usize, ny: usize) -> (&[u32], &[[f64; 3]]) {
+    /// boundary velocities it refers to (lattice units): 0 at rest (outside the membrane, away
+    /// from the liquid), 1 + k behind plate k, 1 + plates + m next to the liquid outside the
+    /// membrane where member m is the nearest.
+    pub fn zone(
+        &mut self,
+        sys: &System,
+        units: &CouplingUnits,
+        nx: usize,
+        ny: usize,
+    ) -> (&[u32], &[[f64; 3]]) {
         let to_lattice = |p: Vec2| {
             let q = units.position_to_lattice([p.x, p.y]);
             Vec2::new(q[0], q[1])
@@ -87,8 +96,42 @@ impl Confinement {
             let z = 1 + k as u32;
             fill(&quad, nx, ny, |i| self.zone[i] = z);
         }
+        // The membrane's own velocity on the outside nodes that border the liquid.
+        let first = self.velocities.len() as u32;
+        let members: Vec<(Vec2, [f64; 3])> = mem
+            .bodies
+            .iter()
+            .map(|&k| {
+                let k = k as usize;
+                let b = &sys.bodies;
+                let v = units.velocity_to_lattice([b.vel[k].x, b.vel[k].y]);
+                (to_lattice(b.pos[k]), [v[0], v[1], 0.0])
+            })
+            .collect();
+        self.velocities.extend(members.iter().map(|m| m.1));
+        for j in 0..ny {
+            for i in 0..nx {
+                if self.zone[j * nx + i] != 0 || !borders_liquid(&self.zone, nx, ny, i, j) {
+                    continue;
+                }
+                let at = Vec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                let nearest = (0..members.len())
+                    .min_by(|&a, &b| {
+                        let (da, db) = ((members[a].0 - at).norm2(), (members[b].0 - at).norm2());
+                        da.total_cmp(&db)
+                    })
+                    .unwrap_or(0);
+                self.zone[j * nx + i] = first + nearest as u32;
+            }
+        }
         (&self.zone, &self.velocities)
     }
+}
+
+/// Whether node (i, j) has a liquid node among its eight neighbours.
+fn borders_liquid(zone: &[u32], nx: usize, ny: usize, i: usize, j: usize) -> bool {
+    (j.saturating_sub(1)..(j + 2).min(ny))
+        .any(|y| (i.saturating_sub(1)..(i + 2).min(nx)).any(|x| zone[y * nx + x] == LIQUID))
 }
 
 /// Call `f(node)` for every node whose centre (i + ½, j + ½) lies inside `poly` (lattice

@@ -29,8 +29,8 @@ pub mod weighting;
 pub use lbdem_core::units::coupled as units;
 
 pub use bounce::{BounceFluid, BounceState};
+pub use confine::Confinement;
 pub use driver::{Coupled, CoupledState};
 pub use error::CouplingError;
 pub use hydro::{Hydro, HydroState, Method};
-pub use confine::Confinement;
 pub use psm::{GrainMotion, LIQUID, Load, PsmFluid, PsmSettings, PsmState, ZoneMass};

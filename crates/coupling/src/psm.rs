@@ -310,7 +310,11 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             u: self.u.clone(),
             local_tau: self.local.as_ref().map(|(_, t)| t.clone()),
             step: self.step,
-            zone: if self.zone_is_set() { self.zone.clone() } else { Vec::new() },
+            zone: if self.zone_is_set() {
+                self.zone.clone()
+            } else {
+                Vec::new()
+            },
             zone_velocities: self.wall_u[self.zone_base..].to_vec(),
             zone_mass: self.zone_mass,
         }
@@ -347,7 +351,11 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
         self.zone_mass = state.zone_mass;
         self.wall_u.truncate(self.zone_base);
         self.wall_u.extend(state.zone_velocities);
-        self.zone = if state.zone.is_empty() { vec![LIQUID; n] } else { state.zone };
+        self.zone = if state.zone.is_empty() {
+            vec![LIQUID; n]
+        } else {
+            state.zone
+        };
         for idx in 0..n {
             self.active[idx] = self.base_active[idx] && self.zone[idx] == LIQUID;
         }
@@ -390,7 +398,10 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
                 zone.len()
             )));
         }
-        if let Some(&z) = zone.iter().find(|&&z| z != LIQUID && z as usize >= velocities.len()) {
+        if let Some(&z) = zone
+            .iter()
+            .find(|&&z| z != LIQUID && z as usize >= velocities.len())
+        {
             return Err(CouplingError::Unsupported(format!(
                 "solid zone refers to boundary velocity {z} of {}",
                 velocities.len()

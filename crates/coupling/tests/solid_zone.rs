@@ -11,11 +11,17 @@ const N: usize = 40;
 fn fluid() -> PsmFluid<f64> {
     // Periodic in x, walls at y = 0 and y = N (the zone lies inside them).
     let wall = Face::Wall { velocity: [0.0; 3] };
-    let domain = Domain::new([N, N, 1], [Face::Periodic, Face::Periodic, wall, wall, wall, wall]);
+    let domain = Domain::new(
+        [N, N, 1],
+        [Face::Periodic, Face::Periodic, wall, wall, wall, wall],
+    );
     let mut f = PsmFluid::<f64>::new(
         &domain,
         PsmSettings {
-            collision: Collision::Trt { tau: 0.7, magic: 0.25 },
+            collision: Collision::Trt {
+                tau: 0.7,
+                magic: 0.25,
+            },
             force: [0.0; 2],
             limits: Limits::default(),
         },
@@ -24,7 +30,10 @@ fn fluid() -> PsmFluid<f64> {
     // A swirl with density variations, so that closing and opening nodes move real mass.
     f.init_equilibrium(|x, y| {
         let (a, b) = (x as f64 / N as f64, y as f64 / N as f64);
-        (1.0 + 0.01 * (6.0 * a).sin() * (5.0 * b).cos(), [0.02 * (6.0 * b).sin(), -0.02 * (6.0 * a).sin()])
+        (
+            1.0 + 0.01 * (6.0 * a).sin() * (5.0 * b).cos(),
+            [0.02 * (6.0 * b).sin(), -0.02 * (6.0 * a).sin()],
+        )
     });
     f
 }
@@ -42,7 +51,10 @@ fn empty_map() -> SolidMap {
 fn disc(r: f64) -> Vec<u32> {
     (0..N * N)
         .map(|i| {
-            let (x, y) = ((i % N) as f64 + 0.5 - 0.5 * N as f64, (i / N) as f64 + 0.5 - 0.5 * N as f64);
+            let (x, y) = (
+                (i % N) as f64 + 0.5 - 0.5 * N as f64,
+                (i / N) as f64 + 0.5 - 0.5 * N as f64,
+            );
             if x * x + y * y < r * r { LIQUID } else { 0 }
         })
         .collect()
@@ -71,7 +83,10 @@ fn a_zone_at_rest_that_breathes_changes_the_liquid_mass_only_by_what_it_closes_a
     // Halfway bounce-back on walls at rest conserves mass exactly; the rest is the zone's
     // bookkeeping (332 nodes closed, 324 opened). Measured: 9.2e-15 relative (round-off).
     let balance = liquid_mass(&f) - (m0 - zm.removed + zm.added);
-    assert!(balance.abs() < 2e-14 * m0, "mass balance off by {balance:e} of {m0}");
+    assert!(
+        balance.abs() < 2e-14 * m0,
+        "mass balance off by {balance:e} of {m0}"
+    );
 }
 
 #[test]
@@ -89,7 +104,8 @@ fn a_zone_moving_sideways_drags_the_liquid_next_to_it() {
             _ => LIQUID,
         })
         .collect();
-    f.set_zone(&zone, &[[uw, 0.0, 0.0], [0.0; 3]]).expect("valid zone");
+    f.set_zone(&zone, &[[uw, 0.0, 0.0], [0.0; 3]])
+        .expect("valid zone");
     let (map, mut loads) = (empty_map(), Vec::new());
     for _ in 0..40_000 {
         f.step(&map, &[], &mut loads).expect("stable");
@@ -104,7 +120,10 @@ fn a_zone_moving_sideways_drags_the_liquid_next_to_it() {
     }
     // TRT with Λ = 1/4 puts halfway bounce-back walls exactly mid-link: the Couette profile is
     // exact once the transient (h²/ν ≈ 15 000 steps) has decayed. Measured: 3.1e-12 of u_w.
-    assert!(worst < 1e-11, "Couette profile off by {worst:e} of the wall speed");
+    assert!(
+        worst < 1e-11,
+        "Couette profile off by {worst:e} of the wall speed"
+    );
     // The x momentum the moving zone put in flows out through the wall at rest: not zero.
     assert!(f.u[(N / 2) * N + N / 2][0] > 0.3 * uw);
 }
@@ -115,26 +134,35 @@ fn a_checkpoint_with_a_zone_resumes_bit_for_bit() {
     let radius = |s: usize| 14.0 - 3.0 * (s as f64 / 15.0).sin();
     let mut a = fluid();
     for s in 0..60 {
-        a.set_zone(&disc(radius(s)), &[[0.001 * s as f64, 0.0, 0.0]]).expect("valid zone");
+        a.set_zone(&disc(radius(s)), &[[0.001 * s as f64, 0.0, 0.0]])
+            .expect("valid zone");
         a.step(&map, &[], &mut loads).expect("stable");
     }
     let mut b = fluid();
     for s in 0..25 {
-        b.set_zone(&disc(radius(s)), &[[0.001 * s as f64, 0.0, 0.0]]).expect("valid zone");
+        b.set_zone(&disc(radius(s)), &[[0.001 * s as f64, 0.0, 0.0]])
+            .expect("valid zone");
         b.step(&map, &[], &mut loads).expect("stable");
     }
     let json = serde_json::to_string(&b.state()).expect("serialisable");
     let mut c = fluid();
-    c.restore(serde_json::from_str(&json).expect("readable")).expect("same lattice");
+    c.restore(serde_json::from_str(&json).expect("readable"))
+        .expect("same lattice");
     for s in 25..60 {
-        c.set_zone(&disc(radius(s)), &[[0.001 * s as f64, 0.0, 0.0]]).expect("valid zone");
+        c.set_zone(&disc(radius(s)), &[[0.001 * s as f64, 0.0, 0.0]])
+            .expect("valid zone");
         c.step(&map, &[], &mut loads).expect("stable");
     }
     // Solid nodes keep stale populations that nothing reads (an opening node is refilled).
     for i in 0..N * N {
         assert_eq!(a.is_active(i), c.is_active(i));
         if a.is_active(i) {
-            assert!(a.f[i * 9..(i + 1) * 9].iter().zip(&c.f[i * 9..(i + 1) * 9]).all(|(x, y)| x.to_bits() == y.to_bits()));
+            assert!(
+                a.f[i * 9..(i + 1) * 9]
+                    .iter()
+                    .zip(&c.f[i * 9..(i + 1) * 9])
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+            );
         }
     }
     assert_eq!(a.zone_mass(), c.zone_mass());

@@ -63,7 +63,13 @@ pub fn read_csv(path: &Path, density: f64) -> Result<Bodies> {
             )
         })
     };
-    let (ig, ix, iy, ir) = (idx("grain_id")?, idx("x")?, idx("y")?, idx("r")?);
+    // A particle snapshot of a run (`body,circle,...,x,y,r,...`) reads back too: its `body`
+    // column is the grain id.
+    let ig = match cols.iter().position(|c| *c == "body") {
+        Some(k) if !cols.contains(&"grain_id") => k,
+        _ => idx("grain_id")?,
+    };
+    let (ix, iy, ir) = (idx("x")?, idx("y")?, idx("r")?);
     let mut grains: BTreeMap<i64, Vec<Ball<Vec2>>> = BTreeMap::new();
     for (ln, line) in lines {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();

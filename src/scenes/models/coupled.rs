@@ -6,6 +6,7 @@
 
 use super::contact_list;
 use super::dry::{grain_columns, grain_sample};
+use super::shear_cell::{self, Origin, Tracked};
 use crate::scenes::build::dem::{build_system, wall_anchor};
 use crate::scenes::build::lattice::{LatticeSetup, setup};
 use crate::scenes::schema::Scene;
@@ -34,7 +35,20 @@ pub struct CoupledModel<T: Real> {
     threshold: f64,
     wall_start: Vec<Vec2>,
     pool: rayon::ThreadPool,
+    /// The push-plate cell of `[shear_cell]`.
+    cell: Option<Tracked>,
+    /// Liquid mass at the start (kg; the liquid inside the sample when it is confined).
+    liquid_mass0: f64,
 }
+
+/// Series columns of the liquid's mass (kg): what the lattice holds, its drift from the start
+/// (relative), and what the moving solid zone closed and opened.
+const MASS_COLUMNS: [&str; 4] = [
+    "liquid_mass",
+    "liquid_mass_drift",
+    "liquid_mass_closed",
+    "liquid_mass_opened",
+];
 
 impl<T: Real> CoupledModel<T> {
     fn new(s: &Scene, su: LatticeSetup, base: &Path) -> Result<Self> {
@@ -49,11 +63,23 @@ impl<T: Real> CoupledModel<T> {
                 cs.depth
             );
         }
-        if let Some((k, _)) = s.walls.iter().enumerate().find(|(_, w)| w.velocity.is_some()) {
-            bail!(
-                "[[walls]] #{k}: moving walls are not seen by the liquid yet (its walls are the [domain] box \
-                 faces, at rest); remove the velocity or use a scene without [fluid]"
-            );
+        let confined_plate = s
+            .shear_cell
+            .as_ref()
+            .filter(|c| c.confine_liquid)
+            .map(|c| crate::scenes::run::wall_index(s, &c.plate))
+            .transpose()?;
+        let mut dem_wall = 0;
+        for (k, w) in s.walls.iter().enumerate() {
+            let here = dem_wall;
+            dem_wall += if w.box_.is_some() { 4 } else { 1 };
+            if w.velocity.is_some() && confined_plate != Some(here) {
+                bail!(
+                    "[[walls]] #{k}: a moving wall is seen by the liquid only as the push-plate of a \
+                     confined sample ([shear_cell] plate, confine_liquid = true); remove the velocity, \
+                     make it the plate, or use a scene without [fluid]"
+                );
+            }
         }
         if su.dim != 2 {
             bail!("a coupled scene is 2D (D2Q9); give [domain] lo and hi with 2 numbers");
@@ -143,14 +169,26 @@ impl<T: Real> CoupledModel<T> {
             .num_threads(threads)
             .build()
             .context("cannot start the thread pool")?;
+        let cell = Tracked::start(s, &run.sys)?;
+        if let (Some(c), Some(sc)) = (&cell, &s.shear_cell)
+            && sc.confine_liquid
+        {
+            run = run
+                .with_confinement(vec![c.cell.plate])
+                .map_err(|e| anyhow::anyhow!("[shear_cell] confine_liquid = true: {e}"))?;
+        }
         let wall_start = run.sys.walls.iter().map(wall_anchor).collect();
-        Ok(Self {
+        let mut m = Self {
             run,
             su,
             threshold: s.output.pressure_threshold,
             wall_start,
             pool,
-        })
+            cell,
+            liquid_mass0: 0.0,
+        };
+        m.liquid_mass0 = m.liquid_mass();
+        Ok(m)
     }
 
     /// Δp of every node (Pa, Su Eq. 19); NaN off the liquid.
@@ -180,6 +218,16 @@ impl<T: Real> CoupledModel<T> {
             }
         }
         (speed_sum / n_active.max(1) as f64 * vscale, max_u)
+    }
+
+    /// Mass of the liquid the lattice holds (kg, over the sample's depth).
+    fn liquid_mass(&self) -> f64 {
+        self.lattice_mass_to_si(self.run.fluid.mass_momentum().0)
+    }
+
+    fn lattice_mass_to_si(&self, m: f64) -> f64 {
+        let u = &self.run.units;
+        m * u.lattice.rho * u.dx() * u.dx() * self.run.depth
     }
 
     pub fn lattice_size(&self) -> [usize; 2] {
@@ -219,6 +267,10 @@ impl<T: Real> Model for CoupledModel<T> {
             ]
             .map(String::from),
         );
+        c.extend(MASS_COLUMNS.map(String::from));
+        if self.cell.is_some() {
+            c.extend(shear_cell::COLUMNS.map(String::from));
+        }
         c
     }
     fn sample(&self) -> Vec<f64> {
@@ -245,6 +297,17 @@ impl<T: Real> Model for CoupledModel<T> {
             mom[0],
             mom[1],
         ]);
+        let m = self.liquid_mass();
+        let zm = run.fluid.zone_mass();
+        v.extend([
+            m,
+            m / self.liquid_mass0 - 1.0,
+            self.lattice_mass_to_si(zm.removed),
+            self.lattice_mass_to_si(zm.added),
+        ]);
+        if let Some(c) = &self.cell {
+            v.extend(c.sample(&run.sys, run.dem_stepper()));
+        }
         v
     }
     fn probe(&self, q: Probe) -> Option<f64> {
@@ -294,6 +357,9 @@ impl<T: Real> Model for CoupledModel<T> {
         )?);
         Ok(out)
     }
+    fn progress_note(&self) -> Option<String> {
+        self.cell.as_ref().map(|c| c.note(&self.run.sys))
+    }
     fn describe(&self) -> serde_json::Value {
         let tm = self.run.timing;
         let total = (tm.lbm + tm.dem + tm.coupling).as_secs_f64().max(1e-12);
@@ -306,7 +372,11 @@ impl<T: Real> Model for CoupledModel<T> {
         })
     }
     fn save(&self) -> Result<serde_json::Value> {
-        Ok(serde_json::json!({ "run": self.run.state(), "wall_start": self.wall_start }))
+        Ok(
+            serde_json::json!({ "run": self.run.state(), "wall_start": self.wall_start,
+                               "cell": self.cell.as_ref().map(Tracked::origin),
+                               "liquid_mass0": self.liquid_mass0 }),
+        )
     }
     fn restore(&mut self, state: serde_json::Value) -> Result<()> {
         #[derive(serde::Deserialize)]
@@ -314,10 +384,17 @@ impl<T: Real> Model for CoupledModel<T> {
         struct S<T: Real> {
             run: lbdem_coupling::driver::CoupledState<T>,
             wall_start: Vec<Vec2>,
+            #[serde(default)]
+            cell: Option<Origin>,
+            liquid_mass0: f64,
         }
         let s: S<T> = serde_json::from_value(state)?;
         self.run.restore(s.run)?;
         self.wall_start = s.wall_start;
+        self.liquid_mass0 = s.liquid_mass0;
+        if let (Some(c), Some(o)) = (&mut self.cell, s.cell) {
+            c.set_origin(o);
+        }
         Ok(())
     }
 }

@@ -2,6 +2,7 @@
 //! loop step), after the optional `[compress]` preparation (Su et al. 2020 Sect. 2.4).
 
 use super::contact_list;
+use super::shear_cell::{self, Origin, Tracked};
 use crate::scenes::build::dem::{build_system, wall_anchor};
 use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::write_particles;
@@ -19,6 +20,8 @@ pub struct Dry {
     /// Where each wall started (the displacement stop condition).
     wall_start: Vec<Vec2>,
     pub critical_dt: f64,
+    /// The push-plate cell of `[shear_cell]`.
+    pub cell: Option<Tracked>,
 }
 
 impl Dry {
@@ -59,6 +62,7 @@ impl Dry {
             stepper = Stepper::new();
         }
         let wall_start = sys.walls.iter().map(wall_anchor).collect();
+        let cell = Tracked::start(s, &sys)?;
         Ok(Self {
             sys,
             stepper,
@@ -67,6 +71,7 @@ impl Dry {
             params,
             wall_start,
             critical_dt: crit,
+            cell,
         })
     }
 
@@ -122,10 +127,18 @@ impl Model for Dry {
         self.params.dt
     }
     fn series_columns(&self) -> Vec<String> {
-        grain_columns(self.sys.walls.len())
+        let mut c = grain_columns(self.sys.walls.len());
+        if self.cell.is_some() {
+            c.extend(shear_cell::COLUMNS.map(String::from));
+        }
+        c
     }
     fn sample(&self) -> Vec<f64> {
-        grain_sample(&self.sys, &self.stepper)
+        let mut v = grain_sample(&self.sys, &self.stepper);
+        if let Some(c) = &self.cell {
+            v.extend(c.sample(&self.sys, &self.stepper));
+        }
+        v
     }
     fn probe(&self, q: Probe) -> Option<f64> {
         match q {
@@ -145,6 +158,9 @@ impl Model for Dry {
             &contact_list(&self.stepper, &self.sys),
         )
     }
+    fn progress_note(&self) -> Option<String> {
+        self.cell.as_ref().map(|c| c.note(&self.sys))
+    }
     fn describe(&self) -> serde_json::Value {
         serde_json::json!({
             "bodies": self.sys.bodies.len(), "contact_law": law_name(&self.law),
@@ -152,19 +168,27 @@ impl Model for Dry {
         })
     }
     fn save(&self) -> Result<serde_json::Value> {
-        Ok(serde_json::json!({ "system": self.sys, "wall_start": self.wall_start }))
+        Ok(
+            serde_json::json!({ "system": self.sys, "wall_start": self.wall_start,
+                               "cell": self.cell.as_ref().map(Tracked::origin) }),
+        )
     }
     fn restore(&mut self, state: serde_json::Value) -> Result<()> {
         #[derive(serde::Deserialize)]
         struct S {
             system: System,
             wall_start: Vec<Vec2>,
+            #[serde(default)]
+            cell: Option<Origin>,
         }
         let s: S = serde_json::from_value(state)?;
         // Where the walls started is part of the state: a [compress] preparation moved them
         // before the run, and a resumed run does not repeat it.
         self.sys = s.system;
         self.wall_start = s.wall_start;
+        if let (Some(c), Some(o)) = (&mut self.cell, s.cell) {
+            c.set_origin(o);
+        }
         self.stepper = Stepper::new();
         Ok(())
     }

@@ -6,6 +6,7 @@
 pub mod coupled;
 pub mod dry;
 pub mod fluid;
+pub mod shear_cell;
 
 use crate::scenes::snapshot::ContactForce;
 use lbdem_dem::{Stepper, System};

@@ -7,6 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 pub struct Progress {
     bar: ProgressBar,
     trigger: Trigger,
+    label: String,
 }
 
 impl Progress {
@@ -21,6 +22,7 @@ impl Progress {
         Self {
             bar,
             trigger: Trigger::Every((total / 500).max(1)),
+            label: label.to_string(),
         }
     }
 }
@@ -34,6 +36,9 @@ impl Observer for Progress {
     }
     fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
         self.bar.set_position(m.steps_done());
+        if let Some(note) = m.progress_note() {
+            self.bar.set_message(format!("{} {note}", self.label));
+        }
         Ok(Flow::Continue)
     }
     fn finish(&mut self, _m: &mut dyn Model, _cx: &LoopCtx) -> Result<()> {

@@ -13,6 +13,7 @@ mod dem;
 mod fluid;
 mod legacy;
 mod run;
+mod shear_cell;
 
 pub use coupling::CouplingSection;
 pub use dem::{
@@ -24,6 +25,7 @@ pub use fluid::{
     ObstacleSection,
 };
 pub use run::{OutputSection, RunSection, TriggerSpec, WallMoved, WallRef, When};
+pub use shear_cell::ShearCellSection;
 
 use anyhow::{Context, Result, bail};
 use lbdem_dem::Law;
@@ -97,6 +99,8 @@ pub struct Scene {
     pub dem: Option<DemSection>,
     #[serde(default)]
     pub compress: Option<CompressSection>,
+    #[serde(default)]
+    pub shear_cell: Option<ShearCellSection>,
     #[serde(default)]
     pub fluid: Option<FluidSection>,
     #[serde(default)]
@@ -266,7 +270,18 @@ impl Scene {
         if liquid && self.lattice.is_none() {
             bail!("[fluid] needs a [lattice] section (dx and dt or tau)");
         }
-        let grain_only: [(&str, bool); 7] = [
+        if let Some(sc) = &self.shear_cell {
+            if self.membrane.is_none() {
+                bail!("[shear_cell] measures the sample inside its membrane: add [membrane] (and [bonds])");
+            }
+            if !(sc.shear_length > 0.0 && sc.shear_length.is_finite()) {
+                bail!(
+                    "[shear_cell] shear_length = {}: must be a positive length in m (Su: 0.01)",
+                    sc.shear_length
+                );
+            }
+        }
+        let grain_only: [(&str, bool); 8] = [
             ("[contact]", self.contact.is_some()),
             ("[wall_contact]", self.wall_contact.is_some()),
             ("[[walls]]", !self.walls.is_empty()),
@@ -274,6 +289,7 @@ impl Scene {
             ("[membrane]", self.membrane.is_some()),
             ("[dem]", self.dem.is_some()),
             ("[compress]", self.compress.is_some()),
+            ("[shear_cell]", self.shear_cell.is_some()),
         ];
         let liquid_only: [(&str, bool); 2] = [
             ("[boundaries]", self.boundaries.is_some()),

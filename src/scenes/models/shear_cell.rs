@@ -1,0 +1,212 @@
+//! What a shear-cell run records (Su et al. 2020 Sect. 2.5), the same with or without liquid:
+//! the push-plate's displacement and the force the grains put on it, the sample's area A_def
+//! and ε_vol^DEM = ln(A_def/A_0) (Eq. 18: the polygon through the membrane grains' centroids
+//! minus the plate's penetration), the mean effective stress p' of the grains (from the DEM
+//! stress tensor) and the inertial number of Eq. 20.
+
+use crate::scenes::run::wall_index;
+use crate::scenes::schema::Scene;
+use anyhow::{Result, bail};
+use lbdem_dem::polygon::{plate_region, sample_area};
+use lbdem_dem::{Stepper, System, Vec2, Vector, WallMotion, WallShape};
+
+pub const COLUMNS: [&str; 7] = [
+    "plate_displacement",
+    "plate_displacement_d",
+    "plate_force",
+    "sample_area",
+    "eps_vol_dem",
+    "mean_stress",
+    "inertial_number",
+];
+
+/// The push-plate cell of a scene with `[shear_cell]`.
+#[derive(Clone, Debug)]
+pub struct ShearCell {
+    /// The plate's index in `System::walls`.
+    pub plate: usize,
+    /// Unit vector the plate moves along.
+    dir: Vec2,
+    /// The plate's speed (m/s), du_y/dt.
+    speed: f64,
+    /// Membrane members in ring order.
+    order: Vec<usize>,
+    /// γ̇ of Eq. 20 (1/s).
+    shear_rate: f64,
+    /// Mean equivalent-area grain diameter d̄ (m) and mean grain density (kg/m², per depth).
+    pub d_mean: f64,
+    rho: f64,
+}
+
+/// Where the plate's segment starts (moves with it).
+fn anchor(sys: &System, k: usize) -> Vec2 {
+    match sys.walls[k].shape {
+        WallShape::Segment { a, .. } => a,
+        WallShape::Plane { p, .. } => p,
+    }
+}
+
+impl ShearCell {
+    /// The cell of `s` (None without `[shear_cell]`), checked against the built system.
+    pub fn new(s: &Scene, sys: &System) -> Result<Option<Self>> {
+        let Some(sc) = &s.shear_cell else {
+            return Ok(None);
+        };
+        let plate = wall_index(s, &sc.plate).map_err(|e| anyhow::anyhow!("[shear_cell] plate: {e}"))?;
+        let w = &sys.walls[plate];
+        let v = match w.motion {
+            WallMotion::Velocity { v } if v.norm() > 0.0 => v,
+            _ => bail!(
+                "[shear_cell] plate = {:?}: that wall does not move; give it a velocity",
+                sc.plate
+            ),
+        };
+        if plate_region(w).is_none() {
+            bail!(
+                "[shear_cell] plate = {:?}: the push-plate must be a segment wall (a, b), not a plane",
+                sc.plate
+            );
+        }
+        let Some(mem) = &sys.membrane else {
+            bail!("[shear_cell] needs the membrane of [membrane]");
+        };
+        if mem.bodies.len() < 3 {
+            bail!(
+                "[membrane] shell selects {} grains: a sample outline needs at least 3; widen shell",
+                mem.bodies.len()
+            );
+        }
+        let b = &sys.bodies;
+        let n = b.len().max(1) as f64;
+        let d_mean = (0..b.len())
+            .map(|k| (4.0 * b.mass[k] / b.density[k] / std::f64::consts::PI).sqrt())
+            .sum::<f64>()
+            / n;
+        let rho = b.density.iter().sum::<f64>() / n;
+        Ok(Some(Self {
+            plate,
+            dir: v * (1.0 / v.norm()),
+            speed: v.norm(),
+            order: mem.ring_order(),
+            shear_rate: v.norm() / sc.shear_length,
+            d_mean,
+            rho,
+        }))
+    }
+
+    /// A_def of Eq. 18 (m²).
+    pub fn area(&self, sys: &System) -> f64 {
+        let Some(mem) = &sys.membrane else { return 0.0 };
+        let ring = mem.polygon(&self.order, &sys.bodies);
+        let plates: Vec<_> = plate_region(&sys.walls[self.plate]).into_iter().collect();
+        sample_area(&ring, &plates)
+    }
+
+    /// Mean effective stress of the grains, p' = −tr σ / 2 with σ = (1/A) Σ_c f_c ⊗ ℓ_c over the
+    /// grain-grain contacts (f_c the force on the first grain, ℓ_c the branch vector from its
+    /// centroid to the other's): the Love-Weber mean stress, compressive positive, in N/m over
+    /// the sample's depth.
+    pub fn mean_stress(sys: &System, st: &Stepper, area: f64) -> f64 {
+        let b = &sys.bodies;
+        let mut trace = 0.0;
+        for (i, j, f) in st.contact_forces(sys) {
+            let (bi, bj) = (
+                b.circle_body[i as usize] as usize,
+                b.circle_body[j as usize] as usize,
+            );
+            trace += f.dot(b.pos[bj] - b.pos[bi]);
+        }
+        -0.5 * trace / area.max(f64::MIN_POSITIVE)
+    }
+
+    /// Inertial number I = γ̇ d̄ √(ρ/p') (Eq. 20 in the form of da Cruz et al. 2005, Su's ref.
+    /// [120]; Su's γ̇ √(m_grain/P) with m_grain = ¼ρπd̄² is the same up to √(π/4) and the 2D
+    /// units). NaN while the grains carry no stress.
+    pub fn inertial_number(&self, p: f64) -> f64 {
+        if p > 0.0 {
+            self.shear_rate * self.d_mean * (self.rho / p).sqrt()
+        } else {
+            f64::NAN
+        }
+    }
+
+    /// The plate's displacement along its motion (m) since `start`.
+    pub fn displacement(&self, sys: &System, start: Vec2) -> f64 {
+        (anchor(sys, self.plate) - start).dot(self.dir)
+    }
+
+    /// Where the plate starts now.
+    pub fn plate_anchor(&self, sys: &System) -> Vec2 {
+        anchor(sys, self.plate)
+    }
+
+    /// The plate's speed du_y/dt (m/s).
+    pub fn speed(&self) -> f64 {
+        self.speed
+    }
+
+    /// One series row ([`COLUMNS`]); `a0` is the sample area at the start.
+    pub fn sample(&self, sys: &System, st: &Stepper, start: Vec2, a0: f64) -> Vec<f64> {
+        let u = self.displacement(sys, start);
+        let a = self.area(sys);
+        let p = Self::mean_stress(sys, st, a);
+        vec![
+            u,
+            u / self.d_mean,
+            // The grains push back against the plate's motion.
+            -sys.walls[self.plate].force.dot(self.dir),
+            a,
+            (a / a0).ln(),
+            p,
+            self.inertial_number(p),
+        ]
+    }
+}
+
+/// A [`ShearCell`] and where it started: the plate's position and the sample's area A_0 at the
+/// start of the run (kept in checkpoints, so that a resumed run measures from the same origin).
+#[derive(Clone, Debug)]
+pub struct Tracked {
+    pub cell: ShearCell,
+    pub start: Vec2,
+    pub a0: f64,
+}
+
+/// The part of [`Tracked`] a checkpoint keeps.
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Origin {
+    pub start: Vec2,
+    pub a0: f64,
+}
+
+impl Tracked {
+    /// The scene's cell as the system stands now (None without `[shear_cell]`).
+    pub fn start(s: &Scene, sys: &System) -> Result<Option<Self>> {
+        Ok(ShearCell::new(s, sys)?.map(|cell| {
+            let a0 = cell.area(sys);
+            Self {
+                start: cell.plate_anchor(sys),
+                a0,
+                cell,
+            }
+        }))
+    }
+    pub fn origin(&self) -> Origin {
+        Origin {
+            start: self.start,
+            a0: self.a0,
+        }
+    }
+    pub fn set_origin(&mut self, o: Origin) {
+        self.start = o.start;
+        self.a0 = o.a0;
+    }
+    pub fn sample(&self, sys: &System, st: &Stepper) -> Vec<f64> {
+        self.cell.sample(sys, st, self.start, self.a0)
+    }
+    /// "u_y = 2.41 d̄" for the progress bar.
+    pub fn note(&self, sys: &System) -> String {
+        let u = self.cell.displacement(sys, self.start);
+        format!("u_y = {:.2} d̄", u / self.cell.d_mean)
+    }
+}

@@ -1,0 +1,28 @@
+//! `[shear_cell]`: the push-plate cell of Su et al. 2020 (Fig. 1a-b): which wall is the
+//! push-plate, the measures of Sect. 2.5 every run records, and whether the liquid is confined
+//! to the membrane (Fig. 2 step 15).
+
+use super::run::WallRef;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShearCellSection {
+    /// The push-plate: a segment wall (`a`, `b`) with a `velocity`, by name or index.
+    pub plate: WallRef,
+    /// Length over which the plate's displacement rate shears the sample: γ̇ = (du_y/dt) / L in
+    /// the inertial number of Eq. 20 (Su Sect. 3.4: 10 mm).
+    #[serde(default = "ten_mm")]
+    pub shear_length: f64,
+    /// With a liquid: nodes outside the membrane polygon or behind the plate are the "solid
+    /// zone" of Fig. 2 step 15, rebuilt every LBM step (default true).
+    #[serde(default = "yes")]
+    pub confine_liquid: bool,
+}
+
+fn ten_mm() -> f64 {
+    0.01
+}
+fn yes() -> bool {
+    true
+}
