@@ -207,3 +207,28 @@ fn bond_breaks_at_its_strength() {
         );
     }
 }
+
+/// A scene gives the rate-sensitive yield force as F_0 and the plate's rate (Su Eq. 6, Table 1
+/// rows "Simulation I, II and III" and "30 µm/s"): it reads back as F_0 + 1.6e-9 N; a negative
+/// rate is refused.
+#[test]
+fn rate_sensitive_yield_force_reads_from_f0_and_rate() {
+    let law: lbdem_dem::Law = serde_json::from_str(
+        r#"{"law": "plastic", "k_e": 4e-3, "k_p": 1e-7, "f_y": {"f_0": 2.52e-9, "rate": 30e-6},
+            "k_t": 2e-3, "damping": {"ratio": 0.1}, "mu": 0.05}"#,
+    )
+    .expect("valid law");
+    let lbdem_dem::Law::Plastic(p) = law else {
+        panic!("not the plastic law: {law:?}")
+    };
+    assert!(
+        (p.f_y - (2.52e-9 + 1.6e-9)).abs() < 0.02 * 1.6e-9,
+        "F_y = {}",
+        p.f_y
+    );
+    let bad = serde_json::from_str::<lbdem_dem::Law>(
+        r#"{"law": "plastic", "k_e": 4e-3, "k_p": 1e-7, "f_y": {"f_0": 2.52e-9, "rate": -1.0},
+            "k_t": 2e-3, "damping": {"ratio": 0.1}, "mu": 0.05}"#,
+    );
+    assert!(bad.is_err());
+}

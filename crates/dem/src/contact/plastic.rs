@@ -15,7 +15,9 @@ pub struct ElasticPlastic {
     pub k_e: f64,
     /// Slope of the plastic flow regime k_n,p (N/m).
     pub k_p: f64,
-    /// Yield force F_y (N).
+    /// Yield force F_y (N): a number, or `{ f_0 = F_0, rate = du_y/dt }` for the rate-sensitive
+    /// yield of Eq. 6 (F_0 in N, the push-plate's rate in m/s), resolved when read.
+    #[serde(deserialize_with = "yield_force")]
     pub f_y: f64,
     pub k_t: f64,
     pub damping: Damping,
@@ -28,6 +30,36 @@ pub struct ElasticPlastic {
 /// and forces in N.
 pub fn su_yield_force(f0: f64, plate_speed: f64) -> f64 {
     f0 + 2.40e-8 * plate_speed.abs().powf(0.26)
+}
+
+/// F_y as a scene gives it: a number, or F_0 and the plate's rate for Eq. 6.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum YieldSpec {
+    Force(f64),
+    Rate(RateYield),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RateYield {
+    f_0: f64,
+    rate: f64,
+}
+
+fn yield_force<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    match YieldSpec::deserialize(d)? {
+        YieldSpec::Force(f) => Ok(f),
+        YieldSpec::Rate(RateYield { f_0, rate }) => {
+            if !(f_0 >= 0.0 && f_0.is_finite() && rate >= 0.0 && rate.is_finite()) {
+                return Err(serde::de::Error::custom(format!(
+                    "f_y = {{ f_0 = {f_0}, rate = {rate} }}: F_0 (N) and the push-plate rate (m/s) must be \
+                     finite and non-negative (Su et al. 2020 Eq. 6, Table 1)"
+                )));
+            }
+            Ok(su_yield_force(f_0, rate))
+        }
+    }
 }
 
 impl ElasticPlastic {
