@@ -35,6 +35,8 @@ impl Stage for Simulate {
         let mut v = vec![scene.clone()];
         // The files the scene reads (particle CSV, mask image) are inputs too.
         if let Ok(l) = crate::scenes::schema::load(&scene, &p.overrides) {
+            // ...and the files it extends.
+            v.extend(l.sources.iter().skip(1).cloned());
             if let Some(csv) = l.scene.particles.as_ref().and_then(|pc| pc.csv.as_ref()) {
                 v.push(l.base_dir.join(csv));
             }

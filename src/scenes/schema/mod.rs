@@ -40,6 +40,11 @@ pub struct Header {
     pub name: Option<String>,
     #[serde(default)]
     pub description: Option<String>,
+    /// A scene file this one is written over (relative to this file): its sections and keys
+    /// come first, this file's replace them key by key. For families of cases that differ in a
+    /// few values (Su et al. 2020's 4 × 3 matrix).
+    #[serde(default)]
+    pub extends: Option<PathBuf>,
 }
 
 /// `[domain]`: the box (m), 2 or 3 entries per key, and which axes are periodic (for the grains
@@ -141,16 +146,61 @@ pub struct Loaded {
     pub base_dir: PathBuf,
     pub name: String,
     pub path: PathBuf,
+    /// The files the scene was read from: itself, then what it extends.
+    pub sources: Vec<PathBuf>,
 }
 
-/// Read and check the scene file at `path`, with `overrides` (a TOML table of sections and
-/// keys, e.g. from `--set run.steps=100`) merged over it.
-pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
+/// How many `extends` a scene may chain.
+const MAX_EXTENDS: usize = 8;
+
+/// The table of the scene file at `path` with what it extends merged under it, and the files
+/// read (the scene first).
+fn read_table(path: &Path, sources: &mut Vec<PathBuf>) -> Result<(toml::Table, String)> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read scene file {}", path.display()))?;
     let mut value: toml::Table =
         toml::from_str(&text).with_context(|| format!("scene file {} is not valid TOML", path.display()))?;
     legacy::refuse_old_format(&value, path)?;
+    sources.push(path.to_path_buf());
+    let base = value
+        .get_mut("scene")
+        .and_then(|s| s.as_table_mut())
+        .and_then(|s| s.remove("extends"));
+    let Some(base) = base else {
+        return Ok((value, text));
+    };
+    let Some(rel) = base.as_str() else {
+        bail!(
+            "scene file {}: [scene] extends = {base}: give a file name in quotes",
+            path.display()
+        );
+    };
+    let base_path = path.parent().unwrap_or(Path::new(".")).join(rel);
+    if sources.len() > MAX_EXTENDS || sources.contains(&base_path) {
+        bail!(
+            "scene file {}: [scene] extends = {rel:?} makes a chain of {} files or a loop ({}); \
+             extend a file that does not extend this one",
+            path.display(),
+            sources.len(),
+            sources
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(" -> ")
+        );
+    }
+    let (mut merged, _) = read_table(&base_path, sources)
+        .with_context(|| format!("scene file {} extends {rel:?}", path.display()))?;
+    merge(&mut merged, &value);
+    let text = toml::to_string(&merged)?;
+    Ok((merged, text))
+}
+
+/// Read and check the scene file at `path`, with `overrides` (a TOML table of sections and
+/// keys, e.g. from `--set run.steps=100`) merged over it.
+pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
+    let mut sources = Vec::new();
+    let (mut value, text) = read_table(path, &mut sources)?;
     merge(&mut value, overrides);
     // Parse from text so that errors point at the line (overrides are re-serialised).
     let text = if overrides.is_empty() {
@@ -171,6 +221,7 @@ pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
         physics,
         base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         path: path.to_path_buf(),
+        sources,
         scene,
     })
 }

@@ -100,3 +100,38 @@ fn overrides_reach_into_sections() {
     let e = format!("{:#}", load(&p, &bad).unwrap_err());
     assert!(e.contains("did you mean `steps`"), "{e}");
 }
+
+#[test]
+fn a_scene_extends_another_key_by_key_and_loops_are_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let base = super::dry::SCENE.replace("name = ", "description = ");
+    std::fs::write(t.path().join("base.toml"), &base).unwrap();
+    std::fs::write(
+        t.path().join("child.toml"),
+        "[scene]\nextends = \"base.toml\"\n[dem]\nskin = 7.0e-5\n",
+    )
+    .unwrap();
+    let l = load(&t.path().join("child.toml"), &Default::default()).unwrap();
+    let parent = load(&t.path().join("base.toml"), &Default::default()).unwrap();
+    let (c, p) = (l.scene.dem.as_ref().unwrap(), parent.scene.dem.as_ref().unwrap());
+    assert_eq!(c.skin, 7.0e-5);
+    assert_ne!(p.skin, 7.0e-5);
+    assert_eq!(c.dt, p.dt, "keys the child does not give come from the base");
+    assert_eq!(l.name, "child");
+    assert_eq!(l.sources.len(), 2);
+    // a loop
+    std::fs::write(t.path().join("a.toml"), "[scene]\nextends = \"b.toml\"\n").unwrap();
+    std::fs::write(t.path().join("b.toml"), "[scene]\nextends = \"a.toml\"\n").unwrap();
+    let e = format!(
+        "{:#}",
+        load(&t.path().join("a.toml"), &Default::default()).unwrap_err()
+    );
+    assert!(e.contains("loop"), "{e}");
+    // a missing base names the file
+    std::fs::write(t.path().join("c.toml"), "[scene]\nextends = \"gone.toml\"\n").unwrap();
+    let e = format!(
+        "{:#}",
+        load(&t.path().join("c.toml"), &Default::default()).unwrap_err()
+    );
+    assert!(e.contains("gone.toml"), "{e}");
+}
