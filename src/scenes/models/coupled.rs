@@ -140,6 +140,15 @@ impl<T: Real> CoupledModel<T> {
         };
         let law = s.contact.clone().context("[contact] is required")?;
         let wall_law = s.wall_contact.clone().unwrap_or_else(|| law.clone());
+        let (crit, m_min, k_max) = lbdem_dem::Stepper::critical_time_step(&sys, &law, &wall_law);
+        if !(dem.dt > 0.0 && dem.dt <= crit) {
+            bail!(
+                "[dem] dt = {:e} s is above the critical step sqrt(m_min/k_max) = {crit:e} s (lightest \
+                 grain {m_min:e} kg, stiffest contact {k_max:e} N/m): the DEM would be unstable; lower \
+                 [dem] dt (and [lattice] dt with it, keeping a whole ratio)",
+                dem.dt
+            );
+        }
         let mut run = Coupled::new(hydro, sys, law, wall_law, dem.step_params(), units, cs.r_hd)
             .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;
         run.depth = cs.depth;

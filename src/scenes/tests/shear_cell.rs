@@ -241,7 +241,15 @@ fn the_same_cell_without_liquid_records_the_same_measures() {
 #[test]
 fn shear_cell_set_ups_that_cannot_work_are_refused_before_anything_runs() {
     let t = tempfile::tempdir().unwrap();
-    let cases: [(&dyn Fn(String) -> String, &str); 3] = [
+    let cases: [(&dyn Fn(String) -> String, &str); 4] = [
+        (
+            // critical step about 1.5e-5 s (lightest grain 2.4e-7 kg, k_n 1000 N/m)
+            &|s: String| {
+                s.replace("dt = 4.0e-6", "dt = 5.0e-5")
+                    .replace("dt = 5.0e-4 ", "dt = 1.0e-3 ")
+            },
+            "[dem] dt = 5e-5 s is above the critical step",
+        ),
         (
             &|s: String| s.replace("[shear_cell]\nplate = \"plate\"", ""),
             "a moving wall is seen by the liquid only as the push-plate",
