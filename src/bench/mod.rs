@@ -8,6 +8,7 @@ pub mod dem;
 pub mod grains;
 pub mod lbm;
 pub mod radiograph;
+pub mod su2020;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
@@ -27,6 +28,9 @@ pub enum Which {
     Grains,
     /// Coupled LBM-DEM steps per second on a shear-cell-sized case.
     Coupled,
+    /// A Su et al. 2020 shear-cell scene: time per LBM step and per mean diameter of plate
+    /// travel, beside its DEM alone and LBM alone.
+    Su2020,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -44,6 +48,10 @@ pub struct BenchArgs {
     /// Write the results as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// The scene to run (`su2020`; default scenes/su2020/sim1.toml, or the reduced cell with
+    /// --quick).
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -54,6 +62,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Which::Dem => dem::run(a),
         Which::Grains => grains::run(a),
         Which::Coupled => coupled::run(a),
+        Which::Su2020 => su2020::run(a),
     }
 }
 

@@ -21,6 +21,11 @@ use lbdem_lbm::{Collision, Domain, Limits, Real};
 use std::path::{Path, PathBuf};
 
 /// Build the model of a coupled scene.
+/// The model of a coupled scene in f64, whatever its `precision` (benchmarks reach into it).
+pub fn build_f64(s: &Scene, base: &Path) -> Result<CoupledModel<f64>> {
+    CoupledModel::<f64>::new(s, setup(s)?, base)
+}
+
 pub fn build(s: &Scene, base: &Path) -> Result<Box<dyn Model>> {
     let su = setup(s)?;
     match su.precision.as_str() {
@@ -227,6 +232,11 @@ impl<T: Real> CoupledModel<T> {
             }
         }
         (speed_sum / n_active.max(1) as f64 * vscale, max_u)
+    }
+
+    /// The push-plate cell, if the scene has `[shear_cell]`.
+    pub fn shear_cell(&self) -> Option<&Tracked> {
+        self.cell.as_ref()
     }
 
     /// Mass of the liquid the lattice holds (kg, over the sample's depth).

@@ -1,0 +1,126 @@
+//! `lbdem bench su2020 [--scene FILE]`: a Su et al. 2020 shear-cell case (default Simulation I,
+//! `scenes/su2020/sim1.toml`; `--quick`: the reduced cell CI runs) for a few LBM steps: the wall
+//! time per LBM step, per mean diameter of push-plate travel and to u_y = 10 d̄, beside the same
+//! case's DEM alone (the same DEM steps, no liquid) and LBM alone (the same lattice and solid
+//! zone, no grains), measured in the same run: the ratios say what each half costs.
+
+use super::{BenchArgs, median};
+use crate::scenes::models::{coupled, dry::Dry};
+use crate::scenes::schema::load;
+use crate::scenes::timeloop::Model;
+use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// LBM steps per repetition (the DEM alone runs the same number of DEM steps).
+const STEPS: usize = 20;
+
+pub fn run(a: &BenchArgs) -> Result<()> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene: PathBuf = match (&a.scene, a.quick) {
+        (Some(p), _) => p.clone(),
+        (None, true) => root.join("scenes/su2020/reduced-shear-cell.toml"),
+        (None, false) => root.join("scenes/su2020/sim1.toml"),
+    };
+    let l = load(&scene, &Default::default())?;
+    if l.scene.shear_cell.is_none() || l.scene.fluid.is_none() {
+        bail!(
+            "{}: bench su2020 needs a coupled shear-cell scene ([fluid] and [shear_cell])",
+            scene.display()
+        );
+    }
+    let steps = if a.quick { 5 } else { STEPS };
+    let mut dry_scene = l.scene.clone();
+    dry_scene.fluid = None;
+    dry_scene.lattice = None;
+    dry_scene.coupling = None;
+
+    let (mut t_coupled, mut t_dem, mut t_lbm) = (Vec::new(), Vec::new(), Vec::new());
+    let mut info = None;
+    for _ in 0..a.reps.max(1) {
+        let mut m = coupled::build_f64(&l.scene, &l.base_dir).context("building the coupled case")?;
+        let ratio = m.run.units.ratio as usize;
+        let t0 = Instant::now();
+        for _ in 0..steps {
+            m.step(false)?;
+        }
+        t_coupled.push(t0.elapsed().as_secs_f64() / steps as f64);
+        let cell = m.shear_cell().context("the scene has no [shear_cell]")?;
+        info = Some((
+            m.run.sys.bodies.len(),
+            m.lattice_size(),
+            ratio,
+            m.run.units.dt(),
+            cell.cell.speed(),
+            cell.cell.d_mean,
+        ));
+
+        // LBM alone: the same lattice and solid zone, no grains.
+        let r_hd = m.run.r_hd;
+        m.run.fluid.map(&[], &[], r_hd, [false; 2])?;
+        let mut loads = Vec::new();
+        let t0 = Instant::now();
+        for _ in 0..steps {
+            m.run.fluid.step(&[], &mut loads)?;
+        }
+        t_lbm.push(t0.elapsed().as_secs_f64() / steps as f64);
+
+        // DEM alone: the same grains and laws, `ratio` DEM steps per LBM step.
+        let mut d = Dry::build(&dry_scene, &l.base_dir, false)?;
+        let t0 = Instant::now();
+        for _ in 0..steps * ratio {
+            d.step(false)?;
+        }
+        t_dem.push(t0.elapsed().as_secs_f64() / steps as f64);
+    }
+    let Some((grains, n, ratio, dt, speed, d_mean)) = info else {
+        bail!("no repetition ran")
+    };
+    let (c, dm, lb) = (median(&t_coupled), median(&t_dem), median(&t_lbm));
+    // LBM steps per mean diameter of plate travel.
+    let per_d = d_mean / (speed * dt);
+    println!(
+        "su2020 {}: {grains} grains, lattice {} x {}, {ratio} DEM steps per LBM step, d = {:.0} um, \
+         plate {:.3e} m/s, {} threads",
+        l.name,
+        n[0],
+        n[1],
+        d_mean * 1e6,
+        speed,
+        rayon::current_num_threads()
+    );
+    println!(
+        "  coupled  {:9.3} ms per LBM step  {:9.1} s per d  {:9.1} min to 10 d",
+        c * 1e3,
+        c * per_d,
+        10.0 * c * per_d / 60.0
+    );
+    println!(
+        "  DEM only {:9.3} ms per {ratio} DEM steps ({:.2} of coupled)",
+        dm * 1e3,
+        dm / c
+    );
+    println!(
+        "  LBM only {:9.3} ms per LBM step ({:.2} of coupled)",
+        lb * 1e3,
+        lb / c
+    );
+    println!(
+        "  coupling overhead (coupled − DEM − LBM): {:.3} ms per LBM step ({:.2} of coupled); median of {} reps",
+        (c - dm - lb) * 1e3,
+        (c - dm - lb) / c,
+        a.reps.max(1)
+    );
+    if let Some(j) = &a.json {
+        std::fs::write(
+            j,
+            serde_json::to_string_pretty(&serde_json::json!({
+                "scene": l.name, "grains": grains, "lattice": n, "ratio": ratio,
+                "coupled_s_per_lbm_step": c, "dem_s": dm, "lbm_s": lb,
+                "s_per_d": c * per_d, "s_to_10d": 10.0 * c * per_d,
+            }))?,
+        )
+        .with_context(|| format!("cannot write {}", j.display()))?;
+    }
+    Ok(())
+}
