@@ -6,6 +6,7 @@
 
 use super::contact_list;
 use super::dry::{grain_columns, grain_sample};
+use super::packed_zone::{self, PackedZone};
 use super::shear_cell::{self, Origin, Tracked};
 use crate::scenes::build::dem::{build_system, wall_anchor};
 use crate::scenes::build::lattice::{LatticeSetup, setup};
@@ -42,6 +43,8 @@ pub struct CoupledModel<T: Real> {
     pool: rayon::ThreadPool,
     /// The push-plate cell of `[shear_cell]`.
     cell: Option<Tracked>,
+    /// The packed layer of `[packed_zone]`.
+    zone: Option<PackedZone>,
     /// Liquid mass at the start (kg; the liquid inside the sample when it is confined).
     liquid_mass0: f64,
 }
@@ -199,6 +202,7 @@ impl<T: Real> CoupledModel<T> {
             wall_start,
             pool,
             cell,
+            zone: PackedZone::new(s)?,
             liquid_mass0: 0.0,
         };
         m.liquid_mass0 = m.liquid_mass();
@@ -290,6 +294,9 @@ impl<T: Real> Model for CoupledModel<T> {
         if self.cell.is_some() {
             c.extend(shear_cell::COLUMNS.map(String::from));
         }
+        if self.zone.is_some() {
+            c.extend(packed_zone::COLUMNS.map(String::from));
+        }
         c
     }
     fn sample(&self) -> Vec<f64> {
@@ -326,6 +333,9 @@ impl<T: Real> Model for CoupledModel<T> {
         ]);
         if let Some(c) = &self.cell {
             v.extend(c.sample(&run.sys, run.dem_stepper()));
+        }
+        if let Some(z) = &self.zone {
+            v.extend(z.sample(&run.sys));
         }
         v
     }

@@ -2,6 +2,7 @@
 //! loop step), after the optional `[compress]` preparation (Su et al. 2020 Sect. 2.4).
 
 use super::contact_list;
+use super::packed_zone::{self, PackedZone};
 use super::shear_cell::{self, Origin, Tracked};
 use crate::scenes::build::dem::{build_system, wall_anchor};
 use crate::scenes::schema::Scene;
@@ -22,6 +23,8 @@ pub struct Dry {
     pub critical_dt: f64,
     /// The push-plate cell of `[shear_cell]`.
     pub cell: Option<Tracked>,
+    /// The packed layer of `[packed_zone]`.
+    zone: Option<PackedZone>,
 }
 
 impl Dry {
@@ -72,6 +75,7 @@ impl Dry {
             wall_start,
             critical_dt: crit,
             cell,
+            zone: PackedZone::new(s)?,
         })
     }
 
@@ -131,12 +135,18 @@ impl Model for Dry {
         if self.cell.is_some() {
             c.extend(shear_cell::COLUMNS.map(String::from));
         }
+        if self.zone.is_some() {
+            c.extend(packed_zone::COLUMNS.map(String::from));
+        }
         c
     }
     fn sample(&self) -> Vec<f64> {
         let mut v = grain_sample(&self.sys, &self.stepper);
         if let Some(c) = &self.cell {
             v.extend(c.sample(&self.sys, &self.stepper));
+        }
+        if let Some(z) = &self.zone {
+            v.extend(z.sample(&self.sys));
         }
         v
     }

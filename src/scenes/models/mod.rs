@@ -6,6 +6,7 @@
 pub mod coupled;
 pub mod dry;
 pub mod fluid;
+pub mod packed_zone;
 pub mod shear_cell;
 
 use crate::scenes::snapshot::ContactForce;

@@ -12,6 +12,7 @@ mod coupling;
 mod dem;
 mod fluid;
 mod legacy;
+mod packed_zone;
 mod run;
 mod shear_cell;
 
@@ -24,6 +25,7 @@ pub use fluid::{
     BoundariesSection, FaceSection, FluidSection, ForcingSection, LatticeSection, MaskSection,
     ObstacleSection,
 };
+pub use packed_zone::PackedZoneSection;
 pub use run::{OutputSection, RunSection, TriggerSpec, WallMoved, WallRef, When};
 pub use shear_cell::ShearCellSection;
 
@@ -106,6 +108,8 @@ pub struct Scene {
     pub compress: Option<CompressSection>,
     #[serde(default)]
     pub shear_cell: Option<ShearCellSection>,
+    #[serde(default)]
+    pub packed_zone: Option<PackedZoneSection>,
     #[serde(default)]
     pub fluid: Option<FluidSection>,
     #[serde(default)]
@@ -332,7 +336,8 @@ impl Scene {
                 );
             }
         }
-        let grain_only: [(&str, bool); 8] = [
+        let grain_only: [(&str, bool); 9] = [
+            ("[packed_zone]", self.packed_zone.is_some()),
             ("[contact]", self.contact.is_some()),
             ("[wall_contact]", self.wall_contact.is_some()),
             ("[[walls]]", !self.walls.is_empty()),
