@@ -8,6 +8,7 @@ pub mod dem;
 pub mod grains;
 pub mod lbm;
 pub mod radiograph;
+pub mod resolution;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
@@ -27,6 +28,8 @@ pub enum Which {
     Grains,
     /// Coupled LBM-DEM steps per second on a shear-cell-sized case.
     Coupled,
+    /// PSM drag and permeability error against cells per grain diameter and wall time.
+    Resolution,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -44,6 +47,9 @@ pub struct BenchArgs {
     /// Write the results as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Write tables and charts here (`resolution`; default out/bench-resolution).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -54,6 +60,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Which::Dem => dem::run(a),
         Which::Grains => grains::run(a),
         Which::Coupled => coupled::run(a),
+        Which::Resolution => resolution::run(a),
     }
 }
 
