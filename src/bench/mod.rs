@@ -8,6 +8,7 @@ pub mod dem;
 pub mod grains;
 pub mod lbm;
 pub mod radiograph;
+pub mod resolution;
 pub mod su2020;
 
 use anyhow::Result;
@@ -31,6 +32,8 @@ pub enum Which {
     /// A Su et al. 2020 shear-cell scene: time per LBM step and per mean diameter of plate
     /// travel, beside its DEM alone and LBM alone.
     Su2020,
+    /// PSM drag and permeability error against cells per grain diameter and wall time.
+    Resolution,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -52,6 +55,9 @@ pub struct BenchArgs {
     /// --quick).
     #[arg(long)]
     pub scene: Option<PathBuf>,
+    /// Write tables and charts here (`resolution`; default out/bench-resolution).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -63,6 +69,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Which::Grains => grains::run(a),
         Which::Coupled => coupled::run(a),
         Which::Su2020 => su2020::run(a),
+        Which::Resolution => resolution::run(a),
     }
 }
 
