@@ -68,6 +68,7 @@ fn shipped(name: &str) -> String {
 
 mod coupled;
 mod dry;
+mod float;
 mod fluid;
 mod schema;
 mod shear_cell;

@@ -166,7 +166,10 @@ mod tests {
         let v = pz.sample(&sys);
         assert!((v[0] - std::f64::consts::FRAC_PI_4).abs() < 7e-10, "{v:?}");
         assert!((v[1] - 0.2).abs() < 1e-12);
-        assert!((v[2] / (21.0 * std::f64::consts::PI * 0.0025) - 1.0).abs() < 7e-10, "{v:?}");
+        assert!(
+            (v[2] / (21.0 * std::f64::consts::PI * 0.0025) - 1.0).abs() < 7e-10,
+            "{v:?}"
+        );
         // from the bottom nothing is packed: the lowest band is empty
         let bottom = PackedZone { top: false, ..pz };
         assert!(bottom.sample(&sys)[0].is_nan());
