@@ -50,7 +50,7 @@ impl PackedZone {
                 hi[1] - lo[1]
             );
         }
-        if !(p.slower_than > 0.0) {
+        if !(p.slower_than > 0.0 && p.slower_than.is_finite()) {
             bail!(
                 "[packed_zone] slower_than = {}: give a positive speed in m/s",
                 p.slower_than
