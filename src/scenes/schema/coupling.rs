@@ -22,6 +22,10 @@ pub struct CouplingSection {
     /// (Uhlmann 2005); refused unless every grain is at least 1.2 times denser than the liquid.
     #[serde(default)]
     pub interior_liquid_correction: bool,
+    /// `false` turns the liquid off and runs the grains alone (Su et al. 2020 Fig. 11, right
+    /// column: "LBM turned off, skipping steps 9-17"), keeping the scene's other sections.
+    #[serde(default = "yes")]
+    pub liquid: bool,
 }
 
 impl Default for CouplingSection {
@@ -32,12 +36,16 @@ impl Default for CouplingSection {
             depth: 1.0,
             dry_membrane: false,
             interior_liquid_correction: false,
+            liquid: true,
         }
     }
 }
 
 fn r_hd() -> f64 {
     0.8
+}
+fn yes() -> bool {
+    true
 }
 fn one() -> f64 {
     1.0

@@ -373,6 +373,8 @@ impl Scene {
         let physics = match (grains, liquid) {
             (true, false) => Physics::Dry,
             (false, true) => Physics::Fluid,
+            // The liquid switched off: the grains alone (Su Fig. 11, right column).
+            (true, true) if self.coupling.as_ref().is_some_and(|c| !c.liquid) => Physics::Dry,
             (true, true) => Physics::Coupled,
             (false, false) => {
                 bail!("the scene has neither [particles] nor [fluid]: nothing to simulate (docs/scenes.md)")
