@@ -156,6 +156,16 @@ impl Bodies {
         }
     }
 
+    /// Multiply every body's density, mass and moment of inertia by `s` (mass scaling: the
+    /// critical time step grows by √s; areas are unchanged).
+    pub fn scale_mass(&mut self, s: f64) {
+        for b in 0..self.len() {
+            self.density[b] *= s;
+            self.mass[b] *= s;
+            self.inertia[b] *= s;
+        }
+    }
+
     /// Total area of the bodies (mass / density).
     pub fn total_area(&self) -> f64 {
         (0..self.len()).map(|b| self.mass[b] / self.density[b]).sum()

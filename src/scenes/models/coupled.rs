@@ -8,7 +8,7 @@ use super::contact_list;
 use super::dry::{grain_columns, grain_sample};
 use super::packed_zone::{self, PackedZone};
 use super::shear_cell::{self, Origin, Tracked};
-use crate::scenes::build::dem::{build_system, wall_anchor};
+use crate::scenes::build::dem::wall_anchor;
 use crate::scenes::build::lattice::{LatticeSetup, setup};
 use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::{FluidFields, write_fluid, write_particles};
@@ -107,7 +107,7 @@ impl<T: Real> CoupledModel<T> {
                 dem.gravity_factor
             );
         }
-        let sys = build_system(s, base)?;
+        let sys = super::grains(s, base)?;
         let [nx, ny, _] = su.n;
         let domain = Domain::new(su.n, su.faces);
         let tau = su.units.tau;

@@ -4,7 +4,7 @@
 use super::contact_list;
 use super::packed_zone::{self, PackedZone};
 use super::shear_cell::{self, Origin, Tracked};
-use crate::scenes::build::dem::{build_system, wall_anchor};
+use crate::scenes::build::dem::wall_anchor;
 use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::write_particles;
 use crate::scenes::timeloop::{Model, Probe};
@@ -31,7 +31,7 @@ impl Dry {
     /// Build from the scene; `prepare` runs the `[compress]` preparation (not on resume: the
     /// checkpoint holds the prepared state).
     pub fn build(s: &Scene, base: &Path, prepare: bool) -> Result<Self> {
-        let mut sys = build_system(s, base)?;
+        let mut sys = super::grains(s, base)?;
         let law = s.contact.clone().context("[contact] is required")?;
         let wall_law = s.wall_contact.clone().unwrap_or_else(|| law.clone());
         let params = s.dem.as_ref().context("[dem] is required")?.step_params();

@@ -22,3 +22,18 @@ pub fn contact_list(st: &Stepper, sys: &System) -> Vec<ContactForce> {
         })
         .collect()
 }
+
+/// The grains of the scene as the DEM steps them: `build_system` and the `[dem] mass_scale`.
+pub fn grains(s: &crate::scenes::schema::Scene, base: &std::path::Path) -> anyhow::Result<System> {
+    let mut sys = crate::scenes::build::dem::build_system(s, base)?;
+    if let Some(d) = &s.dem {
+        let f = d.mass_scale;
+        if !(f > 0.0 && f.is_finite()) {
+            anyhow::bail!("[dem] mass_scale = {f}: give a positive factor (1 = real masses)");
+        }
+        if f != 1.0 {
+            sys.bodies.scale_mass(f);
+        }
+    }
+    Ok(sys)
+}

@@ -105,6 +105,11 @@ pub struct DemSection {
     /// Local (non-viscous, Cundall) damping α: F_k −= α |F_k| sign(v_k).
     #[serde(default)]
     pub local_damping: f64,
+    /// Mass scaling: every grain's mass and inertia times this factor (default 1), so the
+    /// critical step grows by its square root. For quasi-static runs only: the inertial
+    /// number (Su Eq. 20) the series reports is the scaled run's, √factor times the real one.
+    #[serde(default = "one")]
+    pub mass_scale: f64,
 }
 
 impl DemSection {
