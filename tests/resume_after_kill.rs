@@ -181,3 +181,30 @@ fn resume_without_an_interrupted_run_is_refused() {
     );
     assert!(!out.exists(), "a refused resume left {}", out.display());
 }
+
+/// The reduced Su et al. 2020 shear cell: moving push-plate, membrane, the liquid's solid zone
+/// rebuilt every LBM step (its state is in the checkpoint), shear-cell series.
+#[test]
+fn shear_cell_resumes_bitwise_after_sigkill() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let grains = root.join("scenes/su2020/reduced-grains.csv");
+    let scene = std::fs::read_to_string(root.join("scenes/su2020/reduced-shear-cell.toml"))
+        .unwrap()
+        .replace(
+            "\"reduced-grains.csv\"",
+            &format!("{:?}", grains.to_str().unwrap()),
+        )
+        .replace("time = 0.2\n", "time = 0.04\n")
+        .replace(
+            "series = { every = 20 }",
+            "series = { every = 4 }\ncheckpoints = { every = 8 }",
+        );
+    kill_and_resume(
+        &scene,
+        &[
+            "series.csv",
+            "snapshots/fluid_000000080.csv",
+            "snapshots/particles_000000080.csv",
+        ],
+    );
+}
