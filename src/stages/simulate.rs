@@ -38,7 +38,12 @@ impl Stage for Simulate {
             // ...and the files it extends.
             v.extend(l.sources.iter().skip(1).cloned());
             if let Some(csv) = l.scene.particles.as_ref().and_then(|pc| pc.csv.as_ref()) {
-                v.push(l.base_dir.join(csv));
+                let p = l.base_dir.join(csv);
+                // A snapshot directory stands for its newest particle file.
+                match p.is_dir() {
+                    true => v.extend(crate::scenes::build::particles_csv::newest_snapshot(&p).ok()),
+                    false => v.push(p),
+                }
             }
             if let Some(m) = &l.scene.mask {
                 v.push(l.base_dir.join(&m.image));

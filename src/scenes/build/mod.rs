@@ -4,4 +4,4 @@
 
 pub mod dem;
 pub mod lattice;
-mod particles_csv;
+pub mod particles_csv;

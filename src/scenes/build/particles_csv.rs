@@ -22,6 +22,13 @@ fn metres() -> String {
 }
 
 pub fn read_csv(path: &Path, density: f64) -> Result<Bodies> {
+    let newest;
+    let path = if path.is_dir() {
+        newest = newest_snapshot(path)?;
+        newest.as_path()
+    } else {
+        path
+    };
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read particle file {}", path.display()))?;
     let header_path = path.with_extension("json");
@@ -106,4 +113,27 @@ pub fn read_csv(path: &Path, density: f64) -> Result<Bodies> {
             .with_context(|| format!("{}", path.display()))?;
     }
     Ok(bodies)
+}
+
+/// The newest particle snapshot (`particles_<step>.csv`, highest step) in a run's snapshot
+/// directory: a scene continues from where another run ended (Su Float: the second 10 % cut).
+pub fn newest_snapshot(dir: &Path) -> Result<std::path::PathBuf> {
+    let mut v: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot list {}", dir.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("particles_") && n.ends_with(".csv"))
+        })
+        .collect();
+    v.sort();
+    v.pop().with_context(|| {
+        format!(
+            "{} holds no particles_<step>.csv snapshot: give a particle file, or the snapshots \
+             directory of a finished run",
+            dir.display()
+        )
+    })
 }

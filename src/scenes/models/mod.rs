@@ -23,9 +23,20 @@ pub fn contact_list(st: &Stepper, sys: &System) -> Vec<ContactForce> {
         .collect()
 }
 
-/// The grains of the scene as the DEM steps them: `build_system` and the `[dem] mass_scale`.
+/// The grains of the scene as the DEM steps them: `build_system`, then `[particles]
+/// area_factor` and `[dem] mass_scale`.
 pub fn grains(s: &crate::scenes::schema::Scene, base: &std::path::Path) -> anyhow::Result<System> {
     let mut sys = crate::scenes::build::dem::build_system(s, base)?;
+    if let Some(p) = &s.particles {
+        let f = p.area_factor;
+        if !(f > 0.0 && f.is_finite()) {
+            anyhow::bail!("[particles] area_factor = {f}: give a positive factor (0.9 = 10 % smaller)");
+        }
+        if f != 1.0 {
+            sys.bodies.scale_sizes(f.sqrt());
+            sys.contacts = Default::default();
+        }
+    }
     if let Some(d) = &s.dem {
         let f = d.mass_scale;
         if !(f > 0.0 && f.is_finite()) {

@@ -19,6 +19,10 @@ pub struct ParticlesSection {
     pub csv: Option<PathBuf>,
     #[serde(default)]
     pub generate: Option<GenerateSection>,
+    /// Every grain's area times this factor before the run, about its centroid (Su et al. 2020
+    /// Sect. 2.4, Float: 0.9, "the area of each two-circle grain was reduced by 10 %").
+    #[serde(default = "one")]
+    pub area_factor: f64,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
