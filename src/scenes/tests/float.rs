@@ -46,7 +46,7 @@ fn buoyant_grains_rise_and_pack_at_the_top_until_all_are_still() {
 /// rises as a block and keeps its structure, so the packed fraction falls by the area factor
 /// (measured 0.737 → 0.663); Su's full Float case rearranged and repacked at 0.76.
 #[test]
-fn a_second_area_cut_continues_from_the_last_snapshot_and_repacks() {
+fn a_second_area_cut_continues_from_the_last_snapshot_and_floats_again() {
     let t = tempfile::tempdir().unwrap();
     let first = t.path().join("first");
     simulate(&shipped("su2020/reduced-float.toml"), &first, false).unwrap();
