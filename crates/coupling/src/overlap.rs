@@ -89,6 +89,194 @@ pub fn cell_fraction(c: [f64; 2], r: f64, i: i64, j: i64) -> f64 {
     disk_rect_area(c, r, x, x + 1.0, y, y + 1.0).min(1.0)
 }
 
+/// Angles of a circle as a union of intervals in [0, 2π).
+#[derive(Clone, Copy)]
+struct Arcs {
+    iv: [(f64, f64); 4],
+    n: usize,
+}
+
+const TAU: f64 = std::f64::consts::TAU;
+
+impl Arcs {
+    const ALL: Arcs = Arcs {
+        iv: [(0.0, TAU); 4],
+        n: 1,
+    };
+    const NONE: Arcs = Arcs {
+        iv: [(0.0, 0.0); 4],
+        n: 0,
+    };
+
+    /// [lo, hi] (hi − lo ≤ 2π) folded into [0, 2π).
+    fn span(lo: f64, hi: f64) -> Arcs {
+        let lo_m = lo.rem_euclid(TAU);
+        let hi_m = lo_m + (hi - lo);
+        let mut a = Arcs::NONE;
+        if hi_m <= TAU {
+            a.push(lo_m, hi_m);
+        } else {
+            a.push(lo_m, TAU);
+            a.push(0.0, hi_m - TAU);
+        }
+        a
+    }
+
+    fn push(&mut self, a: f64, b: f64) {
+        if b > a && self.n < 4 {
+            self.iv[self.n] = (a, b);
+            self.n += 1;
+        }
+    }
+
+    fn and(&self, o: &Arcs) -> Arcs {
+        let mut out = Arcs::NONE;
+        for &(a, b) in &self.iv[..self.n] {
+            for &(c, d) in &o.iv[..o.n] {
+                out.push(a.max(c), b.min(d));
+            }
+        }
+        out
+    }
+}
+
+/// Half-width of the chord a line at signed distance `dist` from a circle's centre cuts
+/// (`None` if it misses or touches).
+#[inline]
+fn chord(r: f64, dist: f64) -> Option<f64> {
+    let q = r * r - dist * dist;
+    (q > 0.0).then(|| q.sqrt())
+}
+
+/// Area of `[x0, x1] x [y0, y1] ∩ disk a ∩ disk b` (disks as (centre, radius)), exact to
+/// round-off: by Green's theorem the area is ½∮(x dy − y dx) around the boundary of the
+/// intersection of three convex sets, made of the pieces of each set's boundary that lie inside
+/// the other two, each traversed counter-clockwise. Straight pieces add ½ P × Q, arcs
+/// ½[r²Δθ + r c_x Δsin θ − r c_y Δcos θ]. Every piece ends at a point computed once (a chord
+/// end, or a crossing of the two circles) and both pieces meeting there use it, so the sum
+/// closes to round-off even where a circle grazes an edge.
+pub fn rect_lens_area(a: ([f64; 2], f64), b: ([f64; 2], f64), x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
+    if x1 <= x0 || y1 <= y0 || a.1 <= 0.0 || b.1 <= 0.0 {
+        return 0.0;
+    }
+    // In the rectangle's frame (lower-left corner at the origin) to keep the sums small.
+    let (w, h) = (x1 - x0, y1 - y0);
+    let disks = [
+        ([a.0[0] - x0, a.0[1] - y0], a.1),
+        ([b.0[0] - x0, b.0[1] - y0], b.1),
+    ];
+    let mut area = 0.0;
+    // Edges: (fixed coordinate axis, its value, direction along the other axis, extent).
+    // Bottom y = 0 (+x), right x = w (+y), top y = h (−x), left x = 0 (−y).
+    for (axis, at, forward, len) in [
+        (1, 0.0, true, w),
+        (0, w, true, h),
+        (1, h, false, w),
+        (0, 0.0, false, h),
+    ] {
+        let along = 1 - axis;
+        let (mut lo, mut hi) = (0.0f64, len);
+        for &(c, r) in &disks {
+            match chord(r, at - c[axis]) {
+                Some(s) => {
+                    lo = lo.max(c[along] - s);
+                    hi = hi.min(c[along] + s);
+                }
+                None => hi = lo,
+            }
+        }
+        if hi > lo {
+            let (t0, t1) = if forward { (lo, hi) } else { (hi, lo) };
+            let pt = |t: f64| if axis == 1 { [t, at] } else { [at, t] };
+            let (p, q) = (pt(t0), pt(t1));
+            area += 0.5 * (p[0] * q[1] - p[1] * q[0]);
+        }
+    }
+    // Where the two circles cross (both arcs end there).
+    let (ca, ra) = disks[0];
+    let (cb, rb) = disks[1];
+    let (dx, dy) = (cb[0] - ca[0], cb[1] - ca[1]);
+    let dd = (dx * dx + dy * dy).sqrt();
+    let crossing = if dd > 0.0 && dd < ra + rb && dd > (ra - rb).abs() {
+        let along = (ra * ra - rb * rb + dd * dd) / (2.0 * dd);
+        let half = (ra * ra - along * along).max(0.0).sqrt();
+        let (ux, uy) = (dx / dd, dy / dd);
+        let m = [ca[0] + along * ux, ca[1] + along * uy];
+        // p1 on the right of a→b, p2 on the left.
+        Some((
+            [m[0] + half * uy, m[1] - half * ux],
+            [m[0] - half * uy, m[1] + half * ux],
+        ))
+    } else {
+        None
+    };
+    for k in 0..2 {
+        let (c, r) = disks[k];
+        let or = disks[1 - k].1;
+        let ang = |p: [f64; 2]| (p[1] - c[1]).atan2(p[0] - c[0]);
+        let mut set = Arcs::ALL;
+        // x >= 0, x <= w, y >= 0, y <= h: each keeps the arc between its chord's ends.
+        for (axis, at, keep_above) in [(0, 0.0, true), (0, w, false), (1, 0.0, true), (1, h, false)] {
+            let dist = at - c[axis];
+            let arc = match chord(r, dist) {
+                None => {
+                    // The line misses the circle: all of it on one side.
+                    if (dist < 0.0) == keep_above {
+                        Arcs::ALL
+                    } else {
+                        Arcs::NONE
+                    }
+                }
+                Some(s) => {
+                    let end = |t: f64| if axis == 0 { [at, c[1] + t] } else { [c[0] + t, at] };
+                    let (e1, e2) = (ang(end(-s)), ang(end(s)));
+                    // Counter-clockwise from one end to the other on the kept side: right of a
+                    // vertical line from its lower end, above a horizontal one from its right end.
+                    let (from, to) = match (axis == 0, keep_above) {
+                        (true, true) | (false, false) => (e1, e2),
+                        (true, false) | (false, true) => (e2, e1),
+                    };
+                    let to = if to <= from { to + TAU } else { to };
+                    Arcs::span(from, to)
+                }
+            };
+            set = set.and(&arc);
+        }
+        let inside_other = match crossing {
+            Some((p1, p2)) => {
+                // Circle a's arc inside b runs from p1 to p2 counter-clockwise; b's from p2 to p1.
+                let (from, to) = if k == 0 {
+                    (ang(p1), ang(p2))
+                } else {
+                    (ang(p2), ang(p1))
+                };
+                let to = if to <= from { to + TAU } else { to };
+                Arcs::span(from, to)
+            }
+            None => {
+                // Disjoint, or one inside the other.
+                let inside = dd + r <= or;
+                if inside { Arcs::ALL } else { Arcs::NONE }
+            }
+        };
+        set = set.and(&inside_other);
+        for &(t0, t1) in &set.iv[..set.n] {
+            area += 0.5
+                * (r * r * (t1 - t0) + r * c[0] * (t1.sin() - t0.sin()) - r * c[1] * (t1.cos() - t0.cos()));
+        }
+    }
+    area.clamp(0.0, w * h)
+}
+
+/// Fraction of the unit cell `[i, i+1] x [j, j+1]` covered by the union of two disks:
+/// |C ∩ A| + |C ∩ B| − |C ∩ A ∩ B|, exact to round-off (a two-circle grain, Su Fig. 1c-d).
+pub fn cell_fraction_pair(a: ([f64; 2], f64), b: ([f64; 2], f64), i: i64, j: i64) -> f64 {
+    let (x, y) = (i as f64, j as f64);
+    let fa = disk_rect_area(a.0, a.1, x, x + 1.0, y, y + 1.0);
+    let fb = disk_rect_area(b.0, b.1, x, x + 1.0, y, y + 1.0);
+    (fa + fb - rect_lens_area(a, b, x, x + 1.0, y, y + 1.0)).clamp(0.0, 1.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -178,6 +366,72 @@ mod tests {
             prop_assert!((exact - approx).abs() <= 2.0 * perimeter_cells * cell + 1e-12,
                 "exact {exact} sampled {approx}");
             prop_assert!(exact >= 0.0 && exact <= (w * h).min(PI * r * r) + 1e-12);
+        }
+    }
+
+    /// Area of the lens of two disks (closed form).
+    fn lens(r1: f64, r2: f64, d: f64) -> f64 {
+        if d >= r1 + r2 {
+            return 0.0;
+        }
+        if d <= (r1 - r2).abs() {
+            return PI * r1.min(r2).powi(2);
+        }
+        let a1 = ((d * d + r1 * r1 - r2 * r2) / (2.0 * d * r1)).acos();
+        let a2 = ((d * d + r2 * r2 - r1 * r1) / (2.0 * d * r2)).acos();
+        r1 * r1 * (a1 - a1.sin() * a1.cos()) + r2 * r2 * (a2 - a2.sin() * a2.cos())
+    }
+
+    #[test]
+    fn lens_pieces_over_the_cells_add_up_to_the_lens() {
+        for (ca, ra, cb, rb) in [
+            ([3.3, 2.7], 1.2, [3.9, 2.9], 1.2),
+            ([3.3, 2.7], 1.2, [3.3, 2.7], 0.7),
+            ([5.01, 5.0], 2.0, [6.5, 6.1], 1.5),
+            ([4.0, 4.0], 1.0, [6.5, 4.0], 1.0),
+            ([4.5, 4.5], 1.0, [4.5, 5.5], 1.0),
+        ] {
+            let (mut lens_sum, mut union_sum) = (0.0, 0.0);
+            for i in 0..12 {
+                for j in 0..12 {
+                    let (x, y) = (i as f64, j as f64);
+                    lens_sum += rect_lens_area((ca, ra), (cb, rb), x, x + 1.0, y, y + 1.0);
+                    union_sum += cell_fraction_pair((ca, ra), (cb, rb), i, j);
+                }
+            }
+            let d = ((ca[0] - cb[0]).powi(2) + (ca[1] - cb[1]).powi(2)).sqrt();
+            let l = lens(ra, rb, d);
+            assert!((lens_sum - l).abs() < 1e-12, "{ca:?} {cb:?}: {lens_sum} vs {l}");
+            let u = PI * ra * ra + PI * rb * rb - l;
+            assert!((union_sum - u).abs() < 1e-12, "union {union_sum} vs {u}");
+        }
+    }
+
+    fn sampled_pair(a: ([f64; 2], f64), b: ([f64; 2], f64), n: usize) -> f64 {
+        let mut inside = 0usize;
+        for p in 0..n {
+            for q in 0..n {
+                let (x, y) = ((p as f64 + 0.5) / n as f64, (q as f64 + 0.5) / n as f64);
+                let ina = (x - a.0[0]).powi(2) + (y - a.0[1]).powi(2) <= a.1 * a.1;
+                let inb = (x - b.0[0]).powi(2) + (y - b.0[1]).powi(2) <= b.1 * b.1;
+                inside += usize::from(ina && inb);
+            }
+        }
+        inside as f64 / (n * n) as f64
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        /// The lens in a unit cell against 600² midpoint samples (error below two perimeter
+        /// rows of samples).
+        #[test]
+        fn lens_in_a_cell_agrees_with_sampling(ax in -1.0..2.0f64, ay in -1.0..2.0f64, ra in 0.2..1.6f64,
+                                               bx in -1.0..2.0f64, by in -1.0..2.0f64, rb in 0.2..1.6f64) {
+            let exact = rect_lens_area(([ax, ay], ra), ([bx, by], rb), 0.0, 1.0, 0.0, 1.0);
+            let n = 600;
+            let approx = sampled_pair(([ax, ay], ra), ([bx, by], rb), n);
+            let tol = 2.0 * 2.0 * PI * (ra + rb) / n as f64 / n as f64 * 1.0 + 2.0 * 4.0 / n as f64;
+            prop_assert!((exact - approx).abs() <= tol, "exact {exact} sampled {approx}");
         }
     }
 }

@@ -2,13 +2,13 @@
 //! Fig. 1d and Eq. 10), using the hydrodynamic radius factor r_hd in the LBM step only.
 //!
 //! A cell touched by one circle of a grain gets the exact overlap ([`cell_fraction`]).
-//! The circles of one clump overlap each other, so where a cell is cut by two or more
-//! of them the union is sub-sampled on a fixed grid (only those few cells near the
-//! clump's waist). Where several grains cover one cell (at contacts) their fractions are
+//! The circles of one clump overlap each other: where a cell is cut by two of them the
+//! union is exact too ([`cell_fraction_pair`]: the two overlaps minus the lens's); where
+//! three or more cut it (clumps of more circles) it is sub-sampled on a fixed grid. Where several grains cover one cell (at contacts) their fractions are
 //! kept apart (each grain gets its own force, Eq. 14) and scaled down together if they
 //! add up to more than one.
 
-use crate::overlap::cell_fraction;
+use crate::overlap::{cell_fraction, cell_fraction_pair};
 use rayon::prelude::*;
 
 /// One circle of a grain, in lattice units (cell (i, j) spans [i, i+1] x [j, j+1]).
@@ -94,6 +94,16 @@ fn grain_cover(circles: &[GrainCircle], nx: usize, ny: usize, periodic: [bool; 2
                 1.0
             } else if cutting <= 1 {
                 parts.iter().copied().fold(0.0, f64::max)
+            } else if cutting == 2 {
+                let mut two = circles
+                    .iter()
+                    .zip(&parts)
+                    .filter(|(_, f)| **f > 0.0)
+                    .map(|(c, _)| (c.centre, c.radius));
+                match (two.next(), two.next()) {
+                    (Some(a), Some(b)) => cell_fraction_pair(a, b, i, j),
+                    _ => union_fraction(circles, i, j),
+                }
             } else {
                 union_fraction(circles, i, j)
             };
@@ -126,7 +136,8 @@ pub fn solid_map(circles: &[GrainCircle], r_hd: f64, nx: usize, ny: usize, perio
         .map(|g| grain_cover(g, nx, ny, periodic))
         .collect();
     let mut covers: Vec<CellCover> = per_grain.into_iter().flatten().collect();
-    covers.sort_by_key(|c| (c.cell, c.body));
+    // (cell, body) pairs are unique, so the unstable parallel sort is deterministic.
+    covers.par_sort_unstable_by_key(|c| (c.cell, c.body));
     let mut total = vec![0.0; nx * ny];
     for c in &covers {
         total[c.cell as usize] += c.fraction;
