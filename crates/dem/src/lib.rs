@@ -6,6 +6,7 @@
 //! are registered for scenes in [`Law`]; callers add forces through a [`ForceHook`]. No file
 //! I/O here.
 
+pub mod assembly;
 pub mod body;
 pub mod contact;
 pub mod domain;

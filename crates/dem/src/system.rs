@@ -12,6 +12,12 @@ use serde::{Deserialize, Serialize};
 /// The membrane boundary of Su et al. 2020 Sect. 2.4: a bonded ring of grains; each receives an
 /// inward force F_N when it has moved outward from its reference position by more than
 /// `threshold` (Su: 50 µm, F_N = 0.25 F_y, Table 1).
+///
+/// The paper's force is a step. In an explicit integrator a step force on a grain resting at the
+/// threshold switches on and off from one step to the next and keeps it vibrating: with Table
+/// 1's F_N and masses at 0.2 mm depth, about 1e-6 m/s per step, ten times Su's 1e-7 m/s "at
+/// rest" criterion. `ramp` > 0 raises the force linearly over that distance beyond the
+/// threshold instead (0: the paper's step).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Membrane {
     pub bodies: Vec<u32>,
@@ -19,6 +25,8 @@ pub struct Membrane {
     pub centre: Vec2,
     pub threshold: f64,
     pub force: f64,
+    #[serde(default)]
+    pub ramp: f64,
 }
 
 impl Membrane {
@@ -35,6 +43,7 @@ impl Membrane {
             centre,
             threshold,
             force,
+            ramp: 0.0,
         }
     }
 
@@ -47,10 +56,13 @@ impl Membrane {
             return Vec2::ZERO;
         }
         let e = out * (1.0 / l);
-        if (p - self.reference[k]).dot(e) > self.threshold {
-            e * (-self.force)
-        } else {
+        let beyond = (p - self.reference[k]).dot(e) - self.threshold;
+        if beyond <= 0.0 {
             Vec2::ZERO
+        } else if self.ramp > 0.0 && beyond < self.ramp {
+            e * (-self.force * beyond / self.ramp)
+        } else {
+            e * (-self.force)
         }
     }
 }
