@@ -45,6 +45,7 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::radiograph::Radiograph>(&["radiograph"], CliShape::ParamsFile),
     entry::<stages::synth::SynthRadiograph>(&["synth", "radiograph"], CliShape::ParamsFile),
     entry::<stages::digitise::Digitise>(&["digitise"], CliShape::ParamsFile),
+    entry::<stages::assemble::Assemble>(&["assemble"], CliShape::ParamsFile),
     entry::<stages::simulate::Simulate>(&["simulate"], CliShape::SceneFile),
     entry::<stages::settling_study::SettlingStudy>(&["settling-study"], CliShape::ParamsFile),
     entry::<stages::report::Report>(&["report"], CliShape::ParamsFile),

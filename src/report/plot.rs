@@ -565,3 +565,58 @@ mod tests {
         assert_eq!(png_size(&p), (90, 60));
     }
 }
+
+/// A grain circle in metres, for [`grains_png`]; `class` 0 draws grey, 1 red (membrane).
+#[derive(Clone, Copy, Debug)]
+pub struct Disc {
+    pub x: f64,
+    pub y: f64,
+    pub r: f64,
+    pub class: usize,
+}
+
+/// PNG of a grain assembly: filled circles on axes in mm (Su et al. 2020 Fig. 1b: grains grey,
+/// the membrane red), the box [lo, hi] drawn, aspect kept.
+pub fn grains_png(path: &Path, discs: &[Disc], lo: (f64, f64), hi: (f64, f64), title: &str) -> Result<()> {
+    let (w, h) = ((hi.0 - lo.0) * 1e3, (hi.1 - lo.1) * 1e3);
+    if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
+        bail!("cannot draw grains in an empty box {lo:?}..{hi:?}");
+    }
+    let px_h = 900u32;
+    let px_w = ((px_h as f64 - 80.0) * w / h + 100.0)
+        .round()
+        .clamp(300.0, 2400.0) as u32;
+    render_png(path, (px_w, px_h), None, |root| {
+        root.fill(&WHITE).map_err(de)?;
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, 18))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d(lo.0 * 1e3..hi.0 * 1e3, lo.1 * 1e3..hi.1 * 1e3)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("x (mm)")
+            .y_desc("y (mm)")
+            .label_style((FONT, 13))
+            .draw()
+            .map_err(de)?;
+        let plot_w = chart.plotting_area().dim_in_pixel().0 as f64;
+        let px_per_mm = plot_w / w;
+        let grey = RGBColor(150, 150, 150);
+        let red = RGBColor(214, 39, 40);
+        chart
+            .draw_series(discs.iter().map(|d| {
+                let c = if d.class == 1 { red } else { grey };
+                plotters::element::Circle::new(
+                    (d.x * 1e3, d.y * 1e3),
+                    (d.r * 1e3 * px_per_mm).round().max(1.0) as i32,
+                    c.filled(),
+                )
+            }))
+            .map_err(de)?;
+        Ok(())
+    })
+}

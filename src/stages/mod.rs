@@ -3,6 +3,7 @@
 //! [`crate::contract::Stage`] and is listed once in [`crate::registry::STAGES`]. Stages know the
 //! kernels only through their public APIs, and never call the runner or the CLI.
 
+pub mod assemble;
 pub mod digitise;
 pub mod radiograph;
 pub mod report;

@@ -37,13 +37,23 @@ impl Stage for Simulate {
         if let Ok(l) = crate::scenes::schema::load(&scene, &p.overrides) {
             // ...and the files it extends.
             v.extend(l.sources.iter().skip(1).cloned());
-            if let Some(csv) = l.scene.particles.as_ref().and_then(|pc| pc.csv.as_ref()) {
+            let pc = l.scene.particles.as_ref();
+            if let Some(csv) = pc.and_then(|pc| pc.continue_from.as_ref().or(pc.csv.as_ref())) {
                 let p = l.base_dir.join(csv);
                 // A snapshot directory stands for its newest particle file.
                 match p.is_dir() {
                     true => v.extend(crate::scenes::build::particles_csv::newest_snapshot(&p).ok()),
                     false => v.push(p),
                 }
+            }
+            if let Some(a) = pc
+                .and_then(|pc| pc.assembly.as_ref())
+                .filter(|_| pc.is_some_and(|p| p.continue_from.is_none()))
+            {
+                // A missing assembly is refused when the scene is built, with how to make it.
+                let p = l.base_dir.join(&a.file);
+                let h = crate::scenes::build::assembly_file::header_path(&p);
+                v.extend([p, h].into_iter().filter(|f| f.exists()));
             }
             if let Some(m) = &l.scene.mask {
                 v.push(l.base_dir.join(&m.image));

@@ -1,6 +1,6 @@
 //! The DEM system of a scene: particles, box, walls, membrane and its bonds.
 
-use super::particles_csv;
+use super::{assembly_file, particles_csv};
 use crate::scenes::schema::{DomainSection, Scene};
 use anyhow::{Context, Result, bail};
 use lbdem_dem::*;
@@ -13,10 +13,37 @@ fn v(a: [f64; 2]) -> Vec2 {
 /// Build the grains' system from `[particles]`, `[domain]`, `[[walls]]`, `[membrane]` and
 /// `[bonds]`; relative paths resolve from `base`.
 pub fn build_system(s: &Scene, base: &Path) -> Result<System> {
+    let bodies = bodies(s, base)?;
+    let mut sys = System::new(bodies, domain(&s.domain));
+    sys.walls = walls(s)?;
+    if let Some(m) = membrane_spec(s) {
+        assembly::install_membrane(&mut sys, &m);
+    }
+    Ok(sys)
+}
+
+/// The grains of `[particles]`: a particle file, an assembly file or generated.
+pub fn bodies(s: &Scene, base: &Path) -> Result<Bodies> {
     let pc = s.particles.as_ref().context("the scene has no [particles]")?;
-    let bodies = match (&pc.csv, &pc.generate) {
-        (Some(path), None) => particles_csv::read_csv(&base.join(path), pc.density)?,
-        (None, Some(g)) => {
+    if let Some(dir) = &pc.continue_from {
+        return particles_csv::read_csv(&base.join(dir), pc.density)
+            .with_context(|| format!("[particles] continue_from = {:?}", dir.display().to_string()));
+    }
+    Ok(match (&pc.csv, &pc.generate, &pc.assembly) {
+        (Some(path), None, None) => particles_csv::read_csv(&base.join(path), pc.density)?,
+        (None, None, Some(a)) => {
+            let from = format!(
+                "[particles] assembly = {{ file = {:?} }}",
+                a.file.display().to_string()
+            );
+            let expect = assembly_file::Expect {
+                grains: a.grains,
+                d: a.d,
+                from: &from,
+            };
+            assembly_file::read_assembly(&base.join(&a.file), pc.density, &expect)?.0
+        }
+        (None, Some(g), None) => {
             let shapes: Vec<ClumpShape<Vec2>> = g
                 .templates
                 .iter()
@@ -35,16 +62,23 @@ pub fn build_system(s: &Scene, base: &Path) -> Result<System> {
             generate::random_insert(&shapes, &w, pc.density, v(g.lo), v(g.hi), g.count, g.seed)
                 .context("[particles.generate]")?
         }
-        _ => bail!("[particles]: give exactly one of csv = \"FILE.csv\" or a [particles.generate] table"),
-    };
-    let mut sys = System::new(bodies, domain(&s.domain));
+        _ => bail!(
+            "[particles]: give exactly one of csv = \"FILE.csv\", assembly = {{ file, grains, d }} or a \
+             [particles.generate] table"
+        ),
+    })
+}
+
+/// The walls of `[[walls]]`, in order (a box counts four: left, right, bottom, top).
+pub fn walls(s: &Scene) -> Result<Vec<Wall>> {
+    let mut out = Vec::new();
     for (k, w) in s.walls.iter().enumerate() {
         let motion = match w.velocity {
             Some(u) => WallMotion::Velocity { v: v(u) },
             None => WallMotion::Fixed,
         };
         match (w.box_, w.p, w.n, w.a, w.b) {
-            (Some(bx), None, None, None, None) => sys.walls.extend(generate::box_walls(
+            (Some(bx), None, None, None, None) => out.extend(generate::box_walls(
                 Vec2::new(bx[0], bx[1]),
                 Vec2::new(bx[2], bx[3]),
             )),
@@ -55,55 +89,28 @@ pub fn build_system(s: &Scene, base: &Path) -> Result<System> {
                     WallMotion::Velocity { v } => v,
                     _ => Vec2::ZERO,
                 };
-                sys.walls.push(wall)
+                out.push(wall)
             }
-            (None, None, None, Some(a), Some(b)) => sys
-                .walls
-                .push(Wall::new(WallShape::Segment { a: v(a), b: v(b) }, motion)),
+            (None, None, None, Some(a), Some(b)) => {
+                out.push(Wall::new(WallShape::Segment { a: v(a), b: v(b) }, motion))
+            }
             _ => bail!(
                 "[[walls]] #{k}: give either box = [x0, y0, x1, y1], or p and n (plane), or a and b (segment)"
             ),
         }
     }
-    if let Some(m) = &s.membrane {
-        let b = &sys.bodies;
-        let (lo, hi) = (
-            b.pos.iter().fold(Vec2::new(f64::MAX, f64::MAX), |a, p| {
-                Vec2::new(a.x.min(p.x), a.y.min(p.y))
-            }),
-            b.pos.iter().fold(Vec2::new(f64::MIN, f64::MIN), |a, p| {
-                Vec2::new(a.x.max(p.x), a.y.max(p.y))
-            }),
-        );
-        let members: Vec<u32> = (0..b.len())
-            .filter(|&k| {
-                let p = b.pos[k];
-                p.x - lo.x < m.shell || hi.x - p.x < m.shell || p.y - lo.y < m.shell || hi.y - p.y < m.shell
-            })
-            .map(|k| k as u32)
-            .collect();
-        for &k in &members {
-            sys.bodies.tag[k as usize] = 1;
-        }
-        if let Some(bc) = &s.bonds {
-            let b = &sys.bodies;
-            for (x, &i) in members.iter().enumerate() {
-                for &j in &members[x + 1..] {
-                    for ci in b.circle_start[i as usize]..b.circle_start[i as usize + 1] {
-                        for cj in b.circle_start[j as usize]..b.circle_start[j as usize + 1] {
-                            let d = (b.circle_pos(cj) - b.circle_pos(ci)).norm();
-                            if d < b.circle_r[ci] + b.circle_r[cj] + bc.gap {
-                                sys.bonds.push(contact::Bond::new(ci as u32, cj as u32));
-                            }
-                        }
-                    }
-                }
-            }
-            sys.bond_params = Some(bc.params);
-        }
-        sys.membrane = Some(Membrane::new(members, &sys.bodies, m.threshold, m.force));
-    }
-    Ok(sys)
+    Ok(out)
+}
+
+/// The membrane of `[membrane]` and `[bonds]` (Su et al. 2020 Sect. 2.4), if the scene has one.
+pub fn membrane_spec(s: &Scene) -> Option<assembly::MembraneSpec> {
+    s.membrane.as_ref().map(|m| assembly::MembraneSpec {
+        shell: m.shell,
+        threshold: m.threshold,
+        force: m.force,
+        ramp: m.ramp,
+        bonds: s.bonds.as_ref().map(|b| (b.params, b.gap)),
+    })
 }
 
 /// The DEM box of `[domain]` (2D).

@@ -19,10 +19,31 @@ pub struct ParticlesSection {
     pub csv: Option<PathBuf>,
     #[serde(default)]
     pub generate: Option<GenerateSection>,
+    /// An assembly written by `lbdem assemble` (Su et al. 2020 Sect. 2.4), checked against the
+    /// grain set the scene expects.
+    #[serde(default)]
+    pub assembly: Option<AssemblySection>,
+    /// A finished run's `snapshots/` directory (or one particle snapshot): the grains start
+    /// where that run ended, whatever `csv`, `assembly` or `generate` say (Su's Float: the
+    /// second 10 % area cut continues from the first run, `--set particles.continue_from=...`).
+    #[serde(default)]
+    pub continue_from: Option<PathBuf>,
     /// Every grain's area times this factor before the run, about its centroid (Su et al. 2020
     /// Sect. 2.4, Float: 0.9, "the area of each two-circle grain was reduced by 10 %").
     #[serde(default = "one")]
     pub area_factor: f64,
+}
+
+/// `[particles] assembly = { file = "...", grains = N, d = [d_min, d, d_max] }`: the assembly
+/// file and the grain set it must hold (Su Table 2: N^DEM and d_min:d:d_max), so a case cannot
+/// start from another case's grains.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AssemblySection {
+    pub file: PathBuf,
+    pub grains: usize,
+    #[serde(default)]
+    pub d: Option<[f64; 3]>,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -87,6 +108,10 @@ pub struct MembraneSection {
     pub shell: f64,
     pub threshold: f64,
     pub force: f64,
+    /// F_N rises linearly over this distance beyond the threshold (m; 0, the default, is the
+    /// paper's step, which keeps a grain resting at the threshold vibrating: `lbdem_dem::Membrane`).
+    #[serde(default)]
+    pub ramp: f64,
 }
 
 /// `[dem]`: the DEM time step and what acts on every grain.
