@@ -316,16 +316,21 @@ fn mass_scaling_by_ten_leaves_the_strain_and_the_plate_force_unchanged() {
         ));
     }
     let (a, b) = (&runs[0], &runs[1]);
-    // Measured: ε_vol^DEM 0.0157 and 0.0153 (2.5 %), plate force 0.01195 and 0.01168 N (2.3 %),
-    // profiles at most 2.9 µm apart (0.8 % of u_y = 351 µm).
+    eprintln!(
+        "eps_vol_dem {} and {}, plate force {} and {}, u_y {}, profiles {:?} and {:?}",
+        a.0, b.0, a.1, b.1, a.2, a.4, b.4
+    );
+    // Measured (membrane ramp 5 µm, exact two-circle solid fraction): ε_vol^DEM 0.01568 and
+    // 0.01560 (0.50 %), plate force 0.01188 and 0.01170 N (1.6 %), profiles at most 7.8 µm apart
+    // (2.2 % of u_y = 351 µm); the tolerances are about twice these.
     assert!(
-        (a.0 - b.0).abs() < 0.05 * a.0.abs(),
+        (a.0 - b.0).abs() < 0.01 * a.0.abs(),
         "ε_vol^DEM {} and {}",
         a.0,
         b.0
     );
     assert!(
-        (a.1 - b.1).abs() < 0.05 * a.1.abs(),
+        (a.1 - b.1).abs() < 0.035 * a.1.abs(),
         "plate force {} and {}",
         a.1,
         b.1
@@ -335,7 +340,7 @@ fn mass_scaling_by_ten_leaves_the_strain_and_the_plate_force_unchanged() {
             .zip(&b.4)
             .map(|(x, y)| (x - y).abs())
             .fold(0.0, f64::max);
-    assert!(worst < 0.02 * a.2, "profiles {:?} and {:?}", a.4, b.4);
+    assert!(worst < 0.045 * a.2, "profiles {:?} and {:?}", a.4, b.4);
     // Quasi-static (I ≤ 1e-3, Su Sect. 3.4) once the grains carry stress: measured 3.7e-4
     // scaled, 1.2e-4 unscaled at the end.
     let i_end = *b.3.last().unwrap();
