@@ -149,14 +149,13 @@ pub fn run(
             })
         })
         .collect();
-    let s = finish(
+    // `node`, `world` and then `universe` (MPI_Finalize) drop in that order on return.
+    finish(
         sweep,
         out,
         cases,
         &outcomes,
         t0.elapsed().as_secs_f64(),
         size as usize * threads,
-    );
-    drop(universe);
-    s
+    )
 }
