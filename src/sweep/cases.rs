@@ -55,7 +55,7 @@ impl Case {
         }
     }
 
-    /// `pk=84, rate=30, replica 2`: the case for people.
+    /// `pk=84; rate=30; replica 2`: the case for people.
     pub fn label(&self) -> String {
         let mut parts: Vec<String> = self
             .axes
@@ -68,7 +68,7 @@ impl Case {
         if parts.is_empty() {
             "the base case".into()
         } else {
-            parts.join(", ")
+            parts.join("; ") // no comma: the label is a cell of cases.csv
         }
     }
 }
