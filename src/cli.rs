@@ -31,6 +31,7 @@ pub fn command() -> Command {
                         .help("Rerun every stage even when its inputs and parameters are unchanged"),
                 ),
         )
+        .subcommand(sweep_command())
         .subcommand(crate::bench::BenchArgs::augment_args(
             Command::new("bench")
                 .about("Benchmarks: print rates and their ratio to a reference measured in the same run"),
@@ -39,6 +40,50 @@ pub fn command() -> Command {
         cmd = add_stage(cmd, k.cli, k);
     }
     cmd
+}
+
+/// `lbdem sweep SWEEP.toml [--out DIR] [--parallel N] [--threads N] [--force] [--list]`.
+fn sweep_command() -> Command {
+    let count = || clap::value_parser!(usize);
+    Command::new("sweep")
+        .about("Run a scene or pipeline over axes of parameters and random replicas; tables and a report of the results")
+        .arg(
+            Arg::new("sweep")
+                .required(true)
+                .value_parser(clap::value_parser!(PathBuf))
+                .help("The sweep file, e.g. sweeps/su2020-ci.toml (docs/sweeps.md)"),
+        )
+        .arg(
+            Arg::new("out")
+                .long("out")
+                .short('o')
+                .value_parser(clap::value_parser!(PathBuf))
+                .help("Output directory (default: the sweep file's `out`, else out/<name>)"),
+        )
+        .arg(
+            Arg::new("parallel")
+                .long("parallel")
+                .value_parser(count())
+                .help("Cases side by side (default: as many as cores / threads)"),
+        )
+        .arg(
+            Arg::new("threads")
+                .long("threads")
+                .value_parser(count())
+                .help("Threads per case (default: cores / parallel); parallel × threads ≤ cores"),
+        )
+        .arg(
+            Arg::new("force")
+                .long("force")
+                .action(ArgAction::SetTrue)
+                .help("Rerun every case even when it finished before with the same inputs"),
+        )
+        .arg(
+            Arg::new("list")
+                .long("list")
+                .action(ArgAction::SetTrue)
+                .help("Print the cases and their directories, and run nothing"),
+        )
 }
 
 /// Add `kind` at `path` below `cmd`, creating the intermediate groups (`synth`).
@@ -117,6 +162,21 @@ pub fn main() -> Result<()> {
         Some(("run", a)) => {
             let path = a.get_one::<PathBuf>("pipeline").context("PIPELINE is required")?;
             pipeline::run_file(path, a.get_flag("force"))
+        }
+        Some(("sweep", a)) => {
+            let file = a
+                .get_one::<PathBuf>("sweep")
+                .context("SWEEP is required")?
+                .clone();
+            crate::sweep::run(&crate::sweep::Args {
+                file,
+                out: a.get_one::<PathBuf>("out").cloned(),
+                parallel: a.get_one::<usize>("parallel").copied(),
+                threads: a.get_one::<usize>("threads").copied(),
+                force: a.get_flag("force"),
+                list: a.get_flag("list"),
+            })
+            .map(|_| ())
         }
         Some(("bench", a)) => crate::bench::run(&crate::bench::BenchArgs::from_arg_matches(a)?),
         Some((name, a)) => {

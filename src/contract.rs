@@ -26,6 +26,28 @@ pub const CHECKPOINT: &str = "checkpoint.json";
 /// The file name of a pipeline's provenance record, in its output directory.
 pub const PROVENANCE: &str = "provenance.json";
 
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Hide every run's own progress bars and notes for the rest of the process: a sweep runs many
+/// cases side by side under one progress display of its own.
+pub fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether runs keep their progress bars and notes to themselves ([`set_quiet`]).
+pub fn quiet() -> bool {
+    QUIET.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// A progress bar of `len` steps: drawn on a terminal, hidden when [`quiet`].
+pub fn progress_bar(len: u64) -> ProgressBar {
+    if quiet() {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(len)
+    }
+}
+
 /// The code version compiled in: crate version and git commit (with `-dirty`).
 pub fn code_version() -> String {
     format!("{} ({})", env!("CARGO_PKG_VERSION"), env!("LBDEM_GIT_DESCRIBE"))
@@ -111,7 +133,7 @@ impl StageContext {
 
     /// A progress bar for multi-frame or multi-step work; drawn only on a terminal.
     pub fn progress_bar(&self, len: u64, message: &str) -> ProgressBar {
-        let pb = self.progress.add(ProgressBar::new(len));
+        let pb = self.progress.add(progress_bar(len));
         pb.set_style(
             ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} ({eta})")
                 .unwrap_or_else(|_| ProgressStyle::default_bar())

@@ -17,3 +17,4 @@ pub mod registry;
 pub mod report;
 pub mod scenes;
 pub mod stages;
+pub mod sweep;

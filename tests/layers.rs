@@ -12,6 +12,7 @@ const LAYERS: &[&[&str]] = &[
     &["stages"],
     &["registry"],
     &["pipeline"],
+    &["sweep"],
     &["bench", "cli"],
 ];
 

@@ -58,11 +58,13 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
             );
         }
     } else if prepared.resumable && staging.is_dir() {
-        eprintln!(
-            "{:>12}  discarding the interrupted run in {} (use --resume to continue one)",
-            ctx.name,
-            staging.display()
-        );
+        if !crate::contract::quiet() {
+            eprintln!(
+                "{:>12}  discarding the interrupted run in {} (use --resume to continue one)",
+                ctx.name,
+                staging.display()
+            );
+        }
         std::fs::remove_dir_all(&staging).with_context(|| format!("cannot remove {}", staging.display()))?;
     }
     std::fs::create_dir_all(&staging)
@@ -197,6 +199,30 @@ pub fn run_alone(kind: &StageKind, inv: Invocation) -> Result<()> {
 pub fn run_file(path: &Path, force: bool) -> Result<()> {
     let pipeline = schema::Pipeline::load(path)?;
     let out = pipeline.out_dir();
+    run_pipeline(&pipeline, path, &out, RunOpts { force, quiet: false })?;
+    Ok(())
+}
+
+/// How [`run_pipeline`] runs.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOpts {
+    /// Rerun every stage even when its key is unchanged.
+    pub force: bool,
+    /// Print nothing per stage (a sweep runs many pipelines side by side under one progress
+    /// display).
+    pub quiet: bool,
+}
+
+/// Run `pipeline` into `out`, its provenance naming `file` (the pipeline file, or the sweep
+/// file a case comes from). Returns every stage's record, in order. The cache, resume and
+/// atomic outputs are those of [`run_file`]; a sweep runs each case through here.
+pub fn run_pipeline(
+    pipeline: &schema::Pipeline,
+    file: &Path,
+    out: &Path,
+    opts: RunOpts,
+) -> Result<Vec<StageRecord>> {
+    let out = out.to_path_buf();
     let mut planned = Vec::new();
     let mut earlier = Vec::new();
     for spec in &pipeline.stages {
@@ -210,44 +236,56 @@ pub fn run_file(path: &Path, force: bool) -> Result<()> {
         ctx.pipeline_out = Some(out.clone());
         let prepared = registry::find(&spec.kind)
             .and_then(|k| k.prepare(spec.params.clone(), &ctx))
-            .with_context(|| format!("pipeline file {}", path.display()))?;
+            .with_context(|| format!("pipeline file {}", file.display()))?;
         earlier.push((spec.name.clone(), dir));
-        planned.push((ctx, prepared));
+        planned.push((ctx, prepared, spec));
     }
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
-    let mut prov = provenance::start(path, &pipeline)?;
+    let mut prov = provenance::start(file, pipeline)?;
     let t_all = Instant::now();
-    for (mut ctx, prepared) in planned {
-        let record = match (force, cache::reusable(&prepared, &ctx)?) {
+    let say = |m: String| {
+        if !opts.quiet {
+            eprintln!("{m}");
+        }
+    };
+    let mut records = Vec::new();
+    for (mut ctx, prepared, spec) in planned {
+        // Prepared again now that the earlier stages have run: a stage that reads what an
+        // earlier one wrote (a snapshot directory) lists those files among its inputs only now,
+        // and its key must hold them the first time as on every rerun.
+        drop(prepared);
+        let prepared = registry::find(&spec.kind)?.prepare(spec.params.clone(), &ctx)?;
+        let record = match (opts.force, cache::reusable(&prepared, &ctx)?) {
             (false, Some(mut old)) => {
-                eprintln!(
+                say(format!(
                     "{:>12}  unchanged, skipped (ran in {:.2} s before)",
                     ctx.name, old.wall_s
-                );
+                ));
                 old.cached = true;
                 old
             }
             _ => {
                 ctx.resume = prepared.resumable && cache::resumable(&prepared, &ctx)?;
                 let how = if ctx.resume { "resuming" } else { "running" };
-                eprintln!("{:>12}  {how} ({})", ctx.name, prepared.kind);
+                say(format!("{:>12}  {how} ({})", ctx.name, prepared.kind));
                 let r = execute(prepared, &ctx)?;
-                eprintln!("{:>12}  done in {:.2} s", ctx.name, r.wall_s);
+                say(format!("{:>12}  done in {:.2} s", ctx.name, r.wall_s));
                 r
             }
         };
         prov.add(&record, &ctx.out_dir);
         prov.write(&out)?;
+        records.push(record);
     }
     prov.total_wall_s = t_all.elapsed().as_secs_f64();
     prov.write(&out)?;
-    eprintln!(
+    say(format!(
         "pipeline '{}' finished in {:.2} s; outputs in {}",
         pipeline.name,
         prov.total_wall_s,
         out.display()
-    );
-    Ok(())
+    ));
+    Ok(records)
 }
 
 #[cfg(test)]

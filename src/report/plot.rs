@@ -620,3 +620,98 @@ pub fn grains_png(path: &Path, discs: &[Disc], lo: (f64, f64), hi: (f64, f64), t
         Ok(())
     })
 }
+
+/// One series of [`xy_err_png`]: markers joined by a line, with a vertical error bar of
+/// half-width `err[i]` at each point (none where it is not finite).
+#[derive(Clone, Debug)]
+pub struct ErrSeries<'a> {
+    pub label: &'a str,
+    pub x: &'a [f64],
+    pub y: &'a [f64],
+    pub err: &'a [f64],
+}
+
+/// PNG x-y plot (linear axes) of series with error bars: a sweep's result against an axis, one
+/// series per value of the other axes, bars the replicas' confidence interval.
+pub fn xy_err_png(path: &Path, series: &[ErrSeries], opts: &XyPlot) -> Result<()> {
+    for s in series {
+        if s.x.len() != s.y.len() || s.err.len() != s.y.len() {
+            bail!(
+                "series '{}' has {} x, {} y and {} error values",
+                s.label,
+                s.x.len(),
+                s.y.len(),
+                s.err.len()
+            );
+        }
+    }
+    let bar = |e: f64| if e.is_finite() { e.abs() } else { 0.0 };
+    let pts = |s: &ErrSeries| -> Vec<(f64, f64, f64)> {
+        s.x.iter()
+            .zip(s.y)
+            .zip(s.err)
+            .filter(|((x, y), _)| x.is_finite() && y.is_finite())
+            .map(|((&x, &y), &e)| (x, y, bar(e)))
+            .collect()
+    };
+    let all: Vec<(f64, f64, f64)> = series.iter().flat_map(pts).collect();
+    let xs = all.iter().map(|p| p.0);
+    let ys = all.iter().flat_map(|p| [p.1 - p.2, p.1 + p.2]);
+    let (Some((x0, x1)), Some((y0, y1))) = (finite_range(xs), finite_range(ys)) else {
+        bail!("cannot plot '{}': no finite data points", opts.title);
+    };
+    let (x0, x1) = padded(x0, x1, false);
+    let (y0, y1) = padded(y0, y1, false);
+    render_png(path, (800, 560), None, |root| {
+        root.fill(&WHITE).map_err(de)?;
+        let mut chart = ChartBuilder::on(root)
+            .caption(opts.title, (FONT, 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(de)?;
+        chart
+            .configure_mesh()
+            .x_desc(opts.x_label)
+            .y_desc(opts.y_label)
+            .label_style((FONT, 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(de)?;
+        for (i, s) in series.iter().enumerate() {
+            let c = SERIES_COLOURS[i % SERIES_COLOURS.len()];
+            let p = pts(s);
+            chart
+                .draw_series(LineSeries::new(p.iter().map(|q| (q.0, q.1)), c.stroke_width(1)))
+                .map_err(de)?;
+            chart
+                .draw_series(
+                    p.iter().filter(|q| q.2 > 0.0).map(|q| {
+                        ErrorBar::new_vertical(q.0, q.1 - q.2, q.1, q.1 + q.2, c.stroke_width(2), 8)
+                    }),
+                )
+                .map_err(de)?;
+            let anno = chart
+                .draw_series(
+                    p.iter()
+                        .map(|q| plotters::element::Circle::new((q.0, q.1), 4, c.filled())),
+                )
+                .map_err(de)?;
+            if !s.label.is_empty() {
+                anno.label(s.label)
+                    .legend(move |(x, y)| plotters::element::Circle::new((x + 9, y), 4, c.filled()));
+            }
+        }
+        if series.iter().any(|s| !s.label.is_empty()) {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font((FONT, 13))
+                .draw()
+                .map_err(de)?;
+        }
+        Ok(())
+    })
+}

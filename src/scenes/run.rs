@@ -124,8 +124,14 @@ pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResul
     let s = &l.scene;
     // Refuse a bad wall reference before anything is built or written.
     observers(s, 1)?;
+    // `threads = 0` takes the pool the run is called in: all cores alone, a sweep case's share
+    // when cases run side by side.
+    let threads = match s.run.threads {
+        0 => rayon::current_num_threads(),
+        n => n,
+    };
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(s.run.threads)
+        .num_threads(threads)
         .build()
         .context("cannot start the thread pool")?;
     pool.install(|| {
@@ -141,7 +147,7 @@ pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResul
             checkpoints,
         };
         let ending = timeloop::run(m.as_mut(), &mut obs, &cfg)?;
-        if let Some(why) = &ending.stopped {
+        if let Some(why) = ending.stopped.as_ref().filter(|_| !crate::contract::quiet()) {
             eprintln!("{}: {why}; stopping", l.name);
         }
         let mut files = Vec::new();

@@ -170,17 +170,19 @@ impl<T: Real> CoupledModel<T> {
                 .with_interior_liquid_correction()
                 .map_err(|e| anyhow::anyhow!("[coupling] interior_liquid_correction = true: {e}"))?;
         }
-        eprintln!(
-            "coupled: {} grains, lattice {nx} x {ny} (dx = {:e} m, tau = {tau:.4}), LBM dt = {:e} s, \
+        if !crate::contract::quiet() {
+            eprintln!(
+                "coupled: {} grains, lattice {nx} x {ny} (dx = {:e} m, tau = {tau:.4}), LBM dt = {:e} s, \
              DEM dt = {:e} s, ratio {}, {:?}, {}",
-            run.sys.bodies.len(),
-            run.units.dx(),
-            run.units.dt(),
-            run.units.dt_dem,
-            run.units.ratio,
-            cs.method,
-            T::NAME
-        );
+                run.sys.bodies.len(),
+                run.units.dx(),
+                run.units.dt(),
+                run.units.dt_dem,
+                run.units.ratio,
+                cs.method,
+                T::NAME
+            );
+        }
         let threads = s.run.threads;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

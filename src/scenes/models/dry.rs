@@ -36,12 +36,14 @@ impl Dry {
         let wall_law = s.wall_contact.clone().unwrap_or_else(|| law.clone());
         let params = s.dem.as_ref().context("[dem] is required")?.step_params();
         let (crit, m_min, k_max) = Stepper::critical_time_step(&sys, &law, &wall_law);
-        eprintln!(
-            "dem: {} bodies, dt = {:e} s, critical {crit:e} s (m_min {m_min:e} kg, k_max {k_max:e} N/m), law {}",
-            sys.bodies.len(),
-            params.dt,
-            law_name(&law)
-        );
+        if !crate::contract::quiet() {
+            eprintln!(
+                "dem: {} bodies, dt = {:e} s, critical {crit:e} s (m_min {m_min:e} kg, k_max {k_max:e} N/m), law {}",
+                sys.bodies.len(),
+                params.dt,
+                law_name(&law)
+            );
+        }
         let mut stepper = Stepper::new();
         if let (Some(c), true) = (&s.compress, prepare) {
             let n = lbdem_dem::generate::compress_isotropic(
@@ -53,10 +55,12 @@ impl Dry {
                 &mut stepper,
             )
             .context("[compress]")?;
-            eprintln!(
-                "dem: isotropic compression took {n} steps, packing fraction {:.4}",
-                sys.packing_fraction()
-            );
+            if !crate::contract::quiet() {
+                eprintln!(
+                    "dem: isotropic compression took {n} steps, packing fraction {:.4}",
+                    sys.packing_fraction()
+                );
+            }
             if let Some(phi) = c.target_packing {
                 lbdem_dem::generate::scale_to_packing(&mut sys, phi);
             }

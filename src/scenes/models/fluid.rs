@@ -158,15 +158,17 @@ impl<L: Lattice, T: Real> FluidModel<L, T> {
             limits: Limits::default(),
         };
         let engine = make_engine(&su, &mut fluid, settings)?;
-        eprintln!(
-            "fluid: {} {} lattice {:?}, tau = {:.4}, dt = {:e} s, kernel {}",
-            L::NAME,
-            T::NAME,
-            &su.n[..su.dim],
-            su.units.tau,
-            su.units.dt,
-            su.kernel
-        );
+        if !crate::contract::quiet() {
+            eprintln!(
+                "fluid: {} {} lattice {:?}, tau = {:.4}, dt = {:e} s, kernel {}",
+                L::NAME,
+                T::NAME,
+                &su.n[..su.dim],
+                su.units.tau,
+                su.units.dt,
+                su.kernel
+            );
+        }
         Ok(Self {
             su,
             fluid,

@@ -12,7 +12,7 @@ pub struct Progress {
 
 impl Progress {
     pub fn new(total: u64, done: u64, label: &str) -> Self {
-        let bar = ProgressBar::new(total);
+        let bar = crate::contract::progress_bar(total);
         bar.set_style(
             ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} steps, {eta} left")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),

@@ -230,6 +230,12 @@ pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
     })
 }
 
+/// The scene file at `path` as one TOML table, with what it extends merged under it (unchecked):
+/// a sweep resolves keys inside arrays (`walls.plate.velocity`) against it.
+pub fn merged_table(path: &Path) -> Result<toml::Table> {
+    Ok(read_table(path, &mut Vec::new())?.0)
+}
+
 /// The scene's name (`[scene] name`, else the file's stem), without checking the rest.
 pub fn scene_name(path: &Path) -> Result<String> {
     let text = std::fs::read_to_string(path)

@@ -1,0 +1,251 @@
+//! `lbdem sweep` through the real binary: the repository's CI sweep (the reduced shear cell over
+//! grain size and plate rate), its replica sweep in small, and a sweep killed part way (SIGKILL)
+//! that resumes its interrupted case from the checkpoint and ends with the same table.
+
+mod common;
+use common::run;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+fn repo(p: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
+}
+
+fn column(csv: &Path, name: &str) -> Vec<String> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("{name} not in {header:?}"));
+    lines.map(|l| l.split(',').nth(k).unwrap().to_string()).collect()
+}
+
+fn numbers(csv: &Path, name: &str) -> Vec<f64> {
+    column(csv, name).iter().map(|v| v.parse().unwrap()).collect()
+}
+
+/// sweeps/su2020-ci.toml as CI runs it (also under MPI: scripts/mpi-sweep-check.sh).
+#[test]
+fn the_ci_sweep_runs_the_reduced_matrix_and_a_rerun_reuses_every_case() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("ci");
+    let sweep = repo("sweeps/su2020-ci.toml");
+    let (ok, err) = run(&["sweep", sweep.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let res = out.join("results.csv");
+    assert_eq!(column(&res, "case").len(), 4);
+    let (af, rate, eps, drift) = (
+        numbers(&res, "area_factor"),
+        numbers(&res, "rate"),
+        numbers(&res, "eps_vol_half_d"),
+        numbers(&res, "liquid_mass_drift"),
+    );
+    // Rows in the sweep's order: area_factor outermost, then rate.
+    assert_eq!(af, [0.95, 0.95, 1.0, 1.0]);
+    assert_eq!(rate, [2.5e-3, 5e-3, 2.5e-3, 5e-3]);
+    // The looser sample (grains 5 % smaller) contracts ahead of the plate, the dense one dilates
+    // (measured: -0.0080 and -0.0097 against +0.0026 and +0.0031 at half a diameter), the trend
+    // of Su's matrix from low to high %PK (Figs. 7-8).
+    for k in 0..2 {
+        assert!(eps[k] < 0.0 && eps[k + 2] > 0.0, "eps_vol at 0.5 d: {eps:?}");
+    }
+    // The liquid stays in the membrane: measured drift up to 0.42 % at x100 mass scaling.
+    assert!(drift.iter().all(|d| d.abs() < 0.009), "{drift:?}");
+    for f in [
+        "results.parquet",
+        "cases.csv",
+        "index.html",
+        "figures/eps_vol_half_d_vs_rate.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let before = std::fs::read(&res).unwrap();
+    let (ok, err) = run(&["sweep", sweep.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(err.contains("4 of 4 cases finished (4 reused"), "{err}");
+    assert!(
+        std::fs::read(&res).unwrap() == before,
+        "a rerun changed the table"
+    );
+}
+
+/// sweeps/su2020-reduced-replicas.toml with three replicas instead of eight.
+#[test]
+fn replicas_of_the_reduced_cell_give_a_spread_of_the_strain_and_its_interval() {
+    let t = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo("sweeps/su2020-reduced-replicas.toml"))
+        .unwrap()
+        .replace("count = 8", "count = 3")
+        .replace("\"../pipelines/", &format!("\"{}/", repo("pipelines").display()));
+    let f = t.path().join("replicas.toml");
+    std::fs::write(&f, text).unwrap();
+    let out = t.path().join("out");
+    let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let res = out.join("results.csv");
+    assert_eq!(numbers(&res, "seed"), [1.0, 2.0, 3.0]);
+    // Every assembly is scaled to the same packing fraction (reduced-assembly.toml: 0.85).
+    assert!(
+        numbers(&res, "packing_fraction")
+            .iter()
+            .all(|p| (p - 0.85).abs() < 1e-9)
+    );
+    let eps = numbers(&res, "eps_vol_half_d");
+    let spread = eps.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        - eps.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(spread > 0.0, "three assemblies gave the same strain: {eps:?}");
+    let ens = out.join("ensemble.csv");
+    assert_eq!(numbers(&ens, "eps_vol_half_d_n"), [3.0]);
+    let (m, ci) = (
+        numbers(&ens, "eps_vol_half_d_mean")[0],
+        numbers(&ens, "eps_vol_half_d_ci95")[0],
+    );
+    assert!(
+        (m - eps.iter().sum::<f64>() / 3.0).abs() < 1e-15 && ci > 0.0,
+        "{m} ± {ci}"
+    );
+    assert!(out.join("figures/eps_vol_half_d_replicas.png").is_file());
+}
+
+const SCENE: &str = r#"
+[domain]
+lo = [0.0, 0.0]
+hi = [0.01, 0.01]
+[particles]
+density = 2.6
+[particles.generate]
+count = 80
+lo = [0.0, 0.0]
+hi = [0.01, 0.01]
+seed = 5
+templates = [ { circles = [[0.0, 0.0, 3.0e-4], [2.5e-4, 0.0, 2.5e-4]] } ]
+[[walls]]
+box = [0.0, 0.0, 0.01, 0.01]
+[contact]
+law = "linear"
+k_n = 1000.0
+k_t = 500.0
+damping = { ratio = 0.3 }
+mu = 0.5
+[dem]
+dt = 4.0e-6
+skin = 5.0e-5
+gravity = [0.0, -9.81]
+[run]
+steps = 40000
+[output]
+series = { every = 500 }
+snapshots = { count = 1 }
+checkpoints = { every = 2000 }
+"#;
+
+const SWEEP: &str = r#"
+[sweep]
+scene = "scene.toml"
+parallel = 1
+[[axis]]
+name = "mu"
+key = "contact.mu"
+values = [0.3, 0.5]
+[[result]]
+name = "ke"
+column = "kinetic_energy"
+[[result]]
+name = "contacts"
+column = "contacts"
+reduce = "max"
+"#;
+
+#[test]
+fn a_killed_sweep_resumes_its_interrupted_case_and_ends_with_the_same_table() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(t.path().join("scene.toml"), SCENE).unwrap();
+    let f = t.path().join("sweep.toml");
+    std::fs::write(&f, SWEEP).unwrap();
+    let (a, b) = (t.path().join("a"), t.path().join("b"));
+    let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", a.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lbdem"))
+        .args(["sweep", f.to_str().unwrap(), "--out", b.to_str().unwrap()])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    let checkpoint = || {
+        std::fs::read_dir(b.join("cases"))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .any(|e| e.path().join("simulate/.partial/checkpoint.json").is_file())
+    };
+    while !checkpoint() {
+        assert!(t0.elapsed() < Duration::from_secs(120), "no checkpoint appeared");
+        if let Some(s) = child.try_wait().unwrap() {
+            panic!("the sweep ended ({s}) before its first checkpoint: make the scene longer");
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !b.join("results.csv").exists(),
+        "the sweep finished before the kill"
+    );
+    let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", b.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(err.contains("resumed and done"), "no case resumed: {err}");
+    assert!(column(&b.join("cases.csv"), "resumed").contains(&"true".to_string()));
+    assert!(
+        std::fs::read(a.join("results.csv")).unwrap() == std::fs::read(b.join("results.csv")).unwrap(),
+        "the killed and resumed sweep's table differs from the uninterrupted one"
+    );
+}
+
+#[test]
+fn a_bad_sweep_file_is_refused_before_anything_runs() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(t.path().join("scene.toml"), SCENE).unwrap();
+    let f = t.path().join("sweep.toml");
+    let out = t.path().join("out");
+    // A key the scene does not have: refused with the scene's own message, nothing written.
+    std::fs::write(&f, SWEEP.replace("contact.mu", "contact.muu")).unwrap();
+    let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("muu") && err.contains("sweep.toml") && err.contains("case 0"),
+        "{err}"
+    );
+    assert!(!out.exists(), "a refused sweep left {}", out.display());
+    // More threads than cores.
+    std::fs::write(
+        &f,
+        SWEEP.replace("parallel = 1", "parallel = 1\nthreads = 100000"),
+    )
+    .unwrap();
+    let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("threads = 100000") && err.contains("parallel × threads"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // --list prints the cases and runs nothing.
+    std::fs::write(&f, SWEEP).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_lbdem"))
+        .args([
+            "sweep",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--list",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("mu=0.3") && text.contains("mu=0.5"),
+        "{text}"
+    );
+    assert!(!out.exists());
+}
