@@ -65,6 +65,43 @@ pub fn network(n: usize, lo: &[f64], hi: &[f64], pairs: &[(usize, usize)], reach
     }
 }
 
+/// Pairs of distinct grains with circles closer than `gap` (surface to surface; overlapping
+/// circles count). `circles[k] = (grain, [x, y, r])`. A uniform cell grid makes it O(n).
+pub fn near_pairs(circles: &[(usize, [f64; 3])], gap: f64) -> Vec<(usize, usize)> {
+    if circles.is_empty() {
+        return Vec::new();
+    }
+    let rmax = circles.iter().map(|c| c.1[2]).fold(0.0, f64::max);
+    let cell = (2.0 * rmax + gap).max(f64::MIN_POSITIVE);
+    let (x0, y0) = circles.iter().fold((f64::INFINITY, f64::INFINITY), |(a, b), c| {
+        (a.min(c.1[0]), b.min(c.1[1]))
+    });
+    let key = |c: &[f64; 3]| (((c[0] - x0) / cell) as i64, ((c[1] - y0) / cell) as i64);
+    let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> = std::collections::HashMap::new();
+    for (k, c) in circles.iter().enumerate() {
+        cells.entry(key(&c.1)).or_default().push(k);
+    }
+    let mut out = std::collections::BTreeSet::new();
+    for (k, (gk, c)) in circles.iter().enumerate() {
+        let (cx, cy) = key(c);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for &m in cells.get(&(cx + dx, cy + dy)).map_or(&[][..], |v| v.as_slice()) {
+                    let (gm, d) = circles[m];
+                    if m <= k || gm == *gk {
+                        continue;
+                    }
+                    let dist = (c[0] - d[0]).hypot(c[1] - d[1]);
+                    if dist - c[2] - d[2] < gap {
+                        out.insert((*gk.min(&gm), *gk.max(&gm)));
+                    }
+                }
+            }
+        }
+    }
+    out.into_iter().collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -84,5 +121,20 @@ mod tests {
         assert!(!n.percolates);
         assert_eq!(n.largest_cluster_fraction, 0.6);
         assert!(!network(0, &[], &[], &[], 1.0).percolates);
+    }
+
+    #[test]
+    fn near_pairs_finds_gaps_below_the_tolerance_and_skips_circles_of_one_grain() {
+        let c = [
+            (0, [0.0, 0.0, 1.0]),
+            (0, [1.0, 0.0, 1.0]),
+            (1, [3.05, 0.0, 1.0]),
+            (2, [5.2, 0.0, 1.0]),
+            (3, [0.0, 2.0, 1.0]),
+        ];
+        // Grain 0-1 gap 0.05, 1-2 gap 0.15, 0-3 touching.
+        assert_eq!(near_pairs(&c, 0.1), vec![(0, 1), (0, 3)]);
+        assert_eq!(near_pairs(&c, 0.2), vec![(0, 1), (0, 3), (1, 2)]);
+        assert!(near_pairs(&[], 0.1).is_empty());
     }
 }

@@ -79,7 +79,8 @@ impl Grid {
     }
 }
 
-/// Which triangle of `mesh` (on the vertices `points`) holds each pixel centre of `grid`;
+/// Which triangle of `mesh` (on the vertices `points`: the reference positions, or the deformed
+/// ones to paint a field where the material is now) holds each pixel centre of `grid`;
 /// `u32::MAX` outside the mesh. A centre on an edge shared by two triangles goes to the one
 /// listed first, so the map does not depend on the thread count.
 pub fn locate(grid: &Grid, mesh: &Mesh, points: &[P2]) -> Array2<u32> {
@@ -102,7 +103,11 @@ pub fn locate(grid: &Grid, mesh: &Mesh, points: &[P2]) -> Array2<u32> {
         .enumerate()
         .for_each(|(r, mut orow)| {
             for &t in &by_row[r] {
-                let [a, b, c] = mesh.corners(t as usize, points);
+                let [a, mut b, mut c] = mesh.corners(t as usize, points);
+                // A deformed triangle may have turned over: test it counter-clockwise.
+                if crate::mesh::signed_area(a, b, c) < 0.0 {
+                    std::mem::swap(&mut b, &mut c);
+                }
                 let xmin = a[0].min(b[0]).min(c[0]);
                 let xmax = a[0].max(b[0]).max(c[0]);
                 let c0 = ((xmin - grid.x0) / grid.dx - 0.5).floor().max(0.0) as usize;

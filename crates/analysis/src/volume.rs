@@ -62,6 +62,63 @@ pub fn polygon_area(p: &[P2]) -> f64 {
         .abs()
 }
 
+/// The part of `subject` on the left of the directed line a → b (one Sutherland-Hodgman pass).
+fn clip_left(subject: &[P2], a: P2, b: P2) -> Vec<P2> {
+    let side = |p: P2| (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+    let n = subject.len();
+    let mut out = Vec::with_capacity(n + 2);
+    for i in 0..n {
+        let (p, q) = (subject[i], subject[(i + 1) % n]);
+        let (sp, sq) = (side(p), side(q));
+        if sp >= 0.0 {
+            out.push(p);
+        }
+        if (sp >= 0.0) != (sq >= 0.0) {
+            let t = sp / (sp - sq);
+            out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+        }
+    }
+    out
+}
+
+/// Area of `subject ∩ clip` for a simple polygon `subject` and a convex polygon `clip` (either
+/// orientation). For a concave subject the clipped ring may hold zero-width bridges, which add
+/// no area.
+pub fn intersection_area(subject: &[P2], clip: &[P2]) -> f64 {
+    let signed = |p: &[P2]| {
+        let n = p.len();
+        0.5 * (0..n)
+            .map(|i| p[i][0] * p[(i + 1) % n][1] - p[(i + 1) % n][0] * p[i][1])
+            .sum::<f64>()
+    };
+    let mut c = clip.to_vec();
+    if signed(&c) < 0.0 {
+        c.reverse();
+    }
+    let mut poly = subject.to_vec();
+    for i in 0..c.len() {
+        if poly.is_empty() {
+            return 0.0;
+        }
+        poly = clip_left(&poly, c[i], c[(i + 1) % c.len()]);
+    }
+    polygon_area(&poly)
+}
+
+/// The region behind a push-plate's face (`left` → `right`, moving along `dir`): the face swept
+/// back by `depth`, a quadrilateral. Su's A_def (Eq. 18) is the membrane polygon's area minus
+/// its overlap with this region (the plate's penetration).
+pub fn behind_plate(left: P2, right: P2, dir: P2, depth: f64) -> [P2; 4] {
+    let back = |p: P2| [p[0] - depth * dir[0], p[1] - depth * dir[1]];
+    [left, right, back(right), back(left)]
+}
+
+/// A_def of Eq. 18: the area of the polygon through the membrane grains' centroids minus the
+/// plate's penetration.
+pub fn sample_area(ring: &[P2], plate: Option<[P2; 4]>) -> f64 {
+    polygon_area(ring) - plate.map_or(0.0, |q| intersection_area(ring, &q))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,5 +154,27 @@ mod tests {
         r.reverse();
         assert_eq!(polygon_area(&r), 6.0);
         assert_eq!(polygon_area(&sq[..2]), 0.0);
+    }
+
+    /// A 2 × 3 sample with a plate face at y = 0.5 pushed in from below between x = 0.5 and 1.5:
+    /// the plate takes 1 × 0.5 of it.
+    #[test]
+    fn plate_penetration_is_taken_off_the_sample_area() {
+        let ring = [[0.0, 0.0], [2.0, 0.0], [2.0, 3.0], [0.0, 3.0]];
+        let q = behind_plate([0.5, 0.5], [1.5, 0.5], [0.0, 1.0], 10.0);
+        assert!((intersection_area(&ring, &q) - 0.5).abs() < 1e-15);
+        assert!((sample_area(&ring, Some(q)) - 5.5).abs() < 1e-15);
+        assert_eq!(sample_area(&ring, None), 6.0);
+        // A concave (L-shaped) sample: the overlap counts only the material.
+        let l = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ];
+        let q = behind_plate([0.0, 1.5], [2.0, 1.5], [0.0, 1.0], 10.0);
+        assert!((intersection_area(&l, &q) - 2.5).abs() < 1e-15);
     }
 }
