@@ -134,6 +134,7 @@ fn su2020_ci_pipeline_analyses_compares_maps_and_reports() {
     let map = json(&out.join("map/stage.json"));
     assert!(map["output"]["summary"]["cracking_line"].is_object());
     assert_eq!(csv_rows(&out.join("fig11/matrix.csv")), 2);
+    assert!(out.join("fig7/matrix.png").is_file());
 
     // Every figure and table of every stage has a caption; provenance has every stage's wall time.
     let prov = json(&out.join("provenance.json"));

@@ -218,6 +218,42 @@ pub fn packing_fraction(g: &Grains) -> Option<f64> {
     Some(solid / volume::polygon_area(&ring))
 }
 
+/// The fraction of each pixel of the setup's grid covered by the grains' circles (2D grains
+/// span the thickness), 3 × 3 samples per pixel.
+pub fn solid_fraction(s: &Setup, g: &Grains) -> ndarray::Array2<f64> {
+    let grid = &s.grid;
+    let d = s.frame.d_bar;
+    let mut disks = Vec::new();
+    for cs in &g.circles {
+        for c in cs {
+            let q = s.frame.from_scene([c[0], c[1]]);
+            disks.push(lbdem_imaging::synth::Disk {
+                x: (q[0] - grid.x0) / grid.dx,
+                y: (grid.y1() - q[1]) / grid.dx,
+                r: c[2] / d / grid.dx,
+            });
+        }
+    }
+    let beam = lbdem_imaging::synth::Beam {
+        i0: 1.0,
+        mu_s: 1.0,
+        mu_l: 1.0,
+    };
+    lbdem_imaging::synth::render(
+        grid.ny,
+        grid.nx,
+        &disks,
+        3,
+        lbdem_imaging::synth::GrainShape::Cylinder,
+        1.0,
+        1.0,
+        &beam,
+        &[],
+        &[],
+    )
+    .0
+}
+
 fn median(v: &[f64]) -> f64 {
     let mut f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
     if f.is_empty() {
@@ -430,6 +466,10 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
                 crate::io::tiff::write_f32(&out.join("last_dp.tif"), d.view())?;
                 files.push("last_dp.tif".into());
             }
+            // The microstructure (Su Fig. 7): the grains' solid fraction per pixel, liquid 0.
+            let gs = solid_fraction(&setup, &g);
+            crate::io::tiff::write_f32(&out.join("last_gs.tif"), gs.view())?;
+            files.push("last_gs.tif".into());
             last_u = u;
             last_fields = Some(f);
         }
@@ -523,6 +563,7 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
         "fov_d": setup.extent(),
         "grid": setup.grid,
         "last_maps": { "eps_vol": "last_eps_vol.tif", "eps_xy": "last_eps_xy.tif", "dp": "last_dp.tif",
+                       "gs": "last_gs.tif",
                        "u_y_m": last_u, "plate": run.plate.map(|pl| { let (l, r) = pl.corners(last_u);
                            [frame.from_scene(l), frame.from_scene(r)] }) },
         "plate_rate_m_s": rate,

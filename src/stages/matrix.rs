@@ -27,6 +27,8 @@ pub enum Field {
     EpsVol,
     EpsXy,
     Dp,
+    /// The grains' solid fraction per pixel (Su Fig. 7: the deformed microstructures).
+    Microstructure,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -90,6 +92,7 @@ fn load(spec: &str, field: Field, ctx: &StageContext) -> Result<Cell> {
         Field::EpsVol => "eps_vol",
         Field::EpsXy => "eps_xy",
         Field::Dp => "dp",
+        Field::Microstructure => "gs",
     };
     let file = dir.join(v["last_maps"][key].as_str().unwrap_or_default());
     if !file.is_file() {
@@ -220,12 +223,21 @@ fn matrix(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
             }
         })
         .collect();
+    let cmap = if p.field == Field::Microstructure {
+        Colormap::Gray
+    } else {
+        Colormap::Diverging
+    };
     let (label, name) = match p.field {
         Field::EpsVol => ("ε_xx + ε_yy (-)", "ε_xx + ε_yy by triangulation (√10 d̄ REV)"),
         Field::EpsXy => ("ε_xy (-)", "ε_xy = γ_xy/2 by triangulation (√10 d̄ REV)"),
         Field::Dp => (
             "Δp (Pa)",
             "the liquid pressure change Δp (Eq. 19), yellow below Δp_c = −0.03 Pa",
+        ),
+        Field::Microstructure => (
+            "solid fraction (-)",
+            "the deformed microstructure (grains light, liquid black)",
         ),
     };
     let mark = format!("Δp < {} Pa", lbdem_analysis::cracking::DP_C);
@@ -238,8 +250,11 @@ fn matrix(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
             title: &p.title,
             cols: nc,
             label,
-            cmap: Colormap::Diverging,
-            range: p.range.map(|r| (r[0], r[1])),
+            cmap,
+            range: p
+                .range
+                .map(|r| (r[0], r[1]))
+                .or((p.field == Field::Microstructure).then_some((0.0, 1.0))),
             extent: [base.x0, base.x0 + base.nx as f64 * base.dx, base.y0, base.y1()],
             x_label: "x (d_bar)",
             y_label: "y (d_bar)",
