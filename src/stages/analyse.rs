@@ -128,8 +128,7 @@ impl Stage for Analyse {
         "Strain by triangulation, Eq. 18, Δp and cracking, inertial number and net class of a run";
     type Params = Params;
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
-        let dir = run_data::locate(&p.run, ctx);
-        let mut v = vec![dir.join(crate::contract::MANIFEST)];
+        let mut v: Vec<PathBuf> = run_data::manifest_input(&p.run, ctx).into_iter().collect();
         v.extend(p.scene.as_ref().map(|s| ctx.resolve(s)));
         v
     }

@@ -99,10 +99,10 @@ impl Stage for Compare {
         "A radiograph stack beside a simulation run: XIP vs TRI profiles, fields, Δp and agreement";
     type Params = Params;
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
-        let mut v = vec![
-            run_data::locate(&p.radiograph, ctx).join(MANIFEST),
-            run_data::locate(&p.run, ctx).join(MANIFEST),
-        ];
+        let mut v: Vec<PathBuf> = [&p.radiograph, &p.run]
+            .into_iter()
+            .filter_map(|s| run_data::manifest_input(s, ctx))
+            .collect();
         v.extend(p.scene.as_ref().map(|s| ctx.resolve(s)));
         v
     }

@@ -62,6 +62,7 @@ impl Stage for Matrix {
             .iter()
             .filter(|a| !a.is_empty())
             .map(|a| run_data::locate(a, ctx).join(ANALYSIS))
+            .filter(|f| f.is_file() || ctx.earlier.iter().any(|(_, d)| f.starts_with(d)))
             .collect()
     }
     fn run(p: &Params, ctx: &StageContext) -> Result<StageOutput> {

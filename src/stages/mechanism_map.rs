@@ -67,6 +67,7 @@ impl Stage for MechanismMap {
         p.analyses
             .iter()
             .map(|a| run_data::locate(a, ctx).join(ANALYSIS))
+            .filter(|f| f.is_file() || ctx.earlier.iter().any(|(_, d)| f.starts_with(d)))
             .collect()
     }
     fn run(p: &Params, ctx: &StageContext) -> Result<StageOutput> {

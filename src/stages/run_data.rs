@@ -24,6 +24,14 @@ pub fn locate(spec: &str, ctx: &StageContext) -> PathBuf {
     }
 }
 
+/// The manifest of the stage output `spec` names, as an input to hash: always for an earlier
+/// stage of the pipeline (it exists by the time this stage runs), else only if it exists (so
+/// that a wrong path gets the stage's own error, which says what is missing).
+pub fn manifest_input(spec: &str, ctx: &StageContext) -> Option<PathBuf> {
+    let m = locate(spec, ctx).join(MANIFEST);
+    (ctx.earlier_stage(spec.trim_start_matches('@')).is_some() || m.is_file()).then_some(m)
+}
+
 /// One row of `snapshots.csv`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SnapshotEntry {

@@ -129,7 +129,7 @@ impl Stage for SynthRun {
     const ABOUT: &'static str = "Radiographs of a simulation's snapshots (Beer-Lambert through grains and liquid), for the radiograph stage";
     type Params = Params;
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
-        let mut v = vec![run_data::locate(&p.run, ctx).join(crate::contract::MANIFEST)];
+        let mut v: Vec<PathBuf> = run_data::manifest_input(&p.run, ctx).into_iter().collect();
         v.extend(p.scene.as_ref().map(|s| ctx.resolve(s)));
         v
     }
