@@ -59,9 +59,12 @@ pub fn mechanism_map_png(path: &Path, points: &[MapPoint], lines: &[MapLine], ax
     }
     // Right axis: shear rate (1/s) = rate (µm/s) × 1e-6 / width.
     let s = |r: f64| r * 1e-6 / ax.width_m;
-    render_png(path, (900, 680), None, |root| {
+    render_png(path, (1150, 680), None, |root| {
         root.fill(&WHITE).map_err(de)?;
-        let mut chart = ChartBuilder::on(root)
+        // The legend gets its own column so that it hides no point.
+        let (root, side) = root.split_horizontally(880);
+        draw_legend(&side, lines, &ax.legend)?;
+        let mut chart = ChartBuilder::on(&root)
             .caption(&ax.title, (FONT, 20))
             .margin(15)
             .x_label_area_size(45)
@@ -99,13 +102,13 @@ pub fn mechanism_map_png(path: &Path, points: &[MapPoint], lines: &[MapLine], ax
                 .collect();
             chart
                 .draw_series(DashedLineSeries::new(pts, 10, 5, c.stroke_width(2)))
-                .map_err(de)?
-                .label(l.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+                .map_err(de)?;
         }
-        for p in points {
+        let at_of = |p: &MapPoint| (p.g_s0.clamp(g0, g1), p.rate_um_s.clamp(r0, r1));
+        let px: Vec<(i32, i32)> = points.iter().map(|p| chart.backend_coord(&at_of(p))).collect();
+        for (i, p) in points.iter().enumerate() {
             let c = RGBColor(p.colour.0, p.colour.1, p.colour.2);
-            let at = (p.g_s0.clamp(g0, g1), p.rate_um_s.clamp(r0, r1));
+            let at = at_of(p);
             match p.marker {
                 Marker::Experiment => chart
                     .draw_series(std::iter::once(Circle::new(at, 6, c.filled())))
@@ -121,36 +124,64 @@ pub fn mechanism_map_png(path: &Path, points: &[MapPoint], lines: &[MapLine], ax
                     EmptyElement::at(at)
                         + Text::new(
                             p.label.clone(),
-                            (9, -14),
+                            label_offset(i, &p.label, &px),
                             (FONT, 11).into_font().color(&RGBColor(60, 60, 60)),
                         ),
                 ))
                 .map_err(de)?;
         }
-        for (text, col, m) in &ax.legend {
-            let c = RGBColor(col.0, col.1, col.2);
-            let m = *m;
-            chart
-                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
-                .map_err(de)?
-                .label(text.clone())
-                .legend(move |(x, y)| match m {
-                    Marker::Experiment => EmptyElement::at((x + 9, y)) + Circle::new((0, 0), 5, c.filled()),
-                    Marker::Simulation => {
-                        EmptyElement::at((x + 9, y)) + Circle::new((0, 0), 5, c.stroke_width(2))
-                    }
-                });
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font((FONT, 12))
-            .draw()
-            .map_err(de)?;
         Ok(())
     })
+}
+
+/// Where point `i`'s label goes, in pixels from the point: above and to the right, else below,
+/// else to the left, whichever box holds no other point (66 % and 71 % at 30 µm/s, or 50 % at
+/// 2870 µm/s and 57 % at 2150 µm/s, would overlap otherwise).
+fn label_offset(i: usize, label: &str, px: &[(i32, i32)]) -> (i32, i32) {
+    // The embedded font at 11 px is about 6 px per character and 12 px high; markers are 6 px.
+    let (w, h, r) = (6 * label.chars().count() as i32, 12, 7);
+    let (x, y) = px[i];
+    let free = |(dx, dy): (i32, i32)| {
+        let (x0, y0) = (x + dx, y + dy);
+        !px.iter()
+            .enumerate()
+            .any(|(j, &(xj, yj))| j != i && xj + r > x0 && xj - r < x0 + w && yj + r > y0 && yj - r < y0 + h)
+    };
+    let candidates = [(9, -14), (9, 8), (-9 - w, -14), (-9 - w, 8)];
+    candidates.into_iter().find(|&c| free(c)).unwrap_or(candidates[0])
+}
+
+/// The legend column: each line as a dashed stroke, each point kind as its marker.
+fn draw_legend(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    lines: &[MapLine],
+    entries: &[(String, (u8, u8, u8), Marker)],
+) -> Result<()> {
+    let font = (FONT, 13).into_font();
+    let mut y = 70;
+    for l in lines {
+        let c = RGBColor(l.colour.0, l.colour.1, l.colour.2);
+        area.draw(&PathElement::new(vec![(8, y), (20, y)], c.stroke_width(3)))
+            .map_err(de)?;
+        area.draw(&PathElement::new(vec![(24, y), (34, y)], c.stroke_width(3)))
+            .map_err(de)?;
+        area.draw(&Text::new(l.label.clone(), (42, y - 7), font.clone()))
+            .map_err(de)?;
+        y += 24;
+    }
+    y += 8;
+    for (text, col, m) in entries {
+        let c = RGBColor(col.0, col.1, col.2);
+        match m {
+            Marker::Experiment => area.draw(&Circle::new((21, y), 6, c.filled())),
+            Marker::Simulation => area.draw(&Rectangle::new([(15, y - 6), (27, y + 6)], c.stroke_width(3))),
+        }
+        .map_err(de)?;
+        area.draw(&Text::new(text.clone(), (42, y - 7), font.clone()))
+            .map_err(de)?;
+        y += 24;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -190,8 +221,20 @@ mod tests {
             legend: vec![("experiment".into(), (0, 0, 0), Marker::Experiment)],
         };
         mechanism_map_png(&p, &pts, &lines, &ax).unwrap();
-        assert_eq!(image::open(&p).unwrap().width(), 900);
+        assert_eq!(image::open(&p).unwrap().width(), 1150);
         ax.rate_range = (0.0, 1.0);
         assert!(mechanism_map_png(&p, &pts, &lines, &ax).is_err());
+    }
+
+    #[test]
+    fn a_label_moves_off_a_neighbouring_point() {
+        // 66 % and 71 % at 30 µm/s are about 50 px apart on the default map.
+        let px = [(400, 300), (450, 300), (700, 300), (400, 100), (440, 112)];
+        assert_eq!(label_offset(0, "66% - 30 µm/s", &px), (9, 8));
+        assert_eq!(label_offset(1, "71% - 30 µm/s", &px), (9, -14));
+        assert_eq!(label_offset(2, "74% - 1 µm/s", &px), (9, -14));
+        // A neighbour above-right and below-right: the label goes to the left.
+        let px = [(400, 300), (450, 290), (460, 312)];
+        assert_eq!(label_offset(0, "50% - 2870 µm/s", &px), (-9 - 6 * 15, -14));
     }
 }
