@@ -208,7 +208,9 @@ fn colour_bar(area: &DrawingArea<BitMapBackend, Shift>, g: &PanelGrid, lo: f64, 
         .margin_top(30)
         .margin_bottom(20)
         .margin_right(10)
-        .y_label_area_size(95)
+        // A gap on the left keeps the label off the neighbouring panel's frame.
+        .margin_left(15)
+        .y_label_area_size(75)
         .build_cartesian_2d(0.0..1.0, lo..hi)
         .map_err(de)?;
     bar.configure_mesh()
