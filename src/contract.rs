@@ -143,8 +143,16 @@ impl StageContext {
         pb
     }
 
-    /// Resolve a path from the parameters against the pipeline's directory.
+    /// Resolve a path from the parameters against the pipeline's directory. `@name/rest` is
+    /// `rest` inside the output directory of the earlier stage `name` (so a pipeline can feed one
+    /// stage's files to the next wherever its output goes).
     pub fn resolve(&self, p: &Path) -> PathBuf {
+        if let Some(rest) = p.to_str().and_then(|s| s.strip_prefix('@')) {
+            let (name, tail) = rest.split_once('/').unwrap_or((rest, ""));
+            if let Some(d) = self.earlier_stage(name) {
+                return d.join(tail);
+            }
+        }
         if p.is_absolute() {
             p.to_path_buf()
         } else {

@@ -49,6 +49,11 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::simulate::Simulate>(&["simulate"], CliShape::SceneFile),
     entry::<stages::settling_study::SettlingStudy>(&["settling-study"], CliShape::ParamsFile),
     entry::<stages::report::Report>(&["report"], CliShape::ParamsFile),
+    entry::<stages::analyse::Analyse>(&["analyse"], CliShape::ParamsFile),
+    entry::<stages::synth_run::SynthRun>(&["synth", "run"], CliShape::ParamsFile),
+    entry::<stages::compare::Compare>(&["compare"], CliShape::ParamsFile),
+    entry::<stages::mechanism_map::MechanismMap>(&["mechanism-map"], CliShape::ParamsFile),
+    entry::<stages::matrix::Matrix>(&["matrix"], CliShape::ParamsFile),
 ];
 
 /// The stage kind named `kind`, or an error listing the known ones.

@@ -81,9 +81,9 @@ fn cool_warm(t: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
-const FONT: &str = "sans-serif";
-const MASKED: RGBColor = RGBColor(160, 160, 160);
-const SERIES_COLOURS: [RGBColor; 8] = [
+pub(crate) const FONT: &str = "sans-serif";
+pub(crate) const MASKED: RGBColor = RGBColor(160, 160, 160);
+pub(crate) const SERIES_COLOURS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -94,7 +94,7 @@ const SERIES_COLOURS: [RGBColor; 8] = [
     RGBColor(23, 190, 207),
 ];
 
-fn register_font() {
+pub(crate) fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         let bytes: &'static [u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
@@ -106,7 +106,7 @@ fn register_font() {
     });
 }
 
-fn colour(cmap: Colormap, t: f64) -> RGBColor {
+pub(crate) fn colour(cmap: Colormap, t: f64) -> RGBColor {
     let t = t.clamp(0.0, 1.0) as f32;
     match cmap {
         Colormap::Viridis => ViridisRGB::get_color(t),
@@ -116,7 +116,7 @@ fn colour(cmap: Colormap, t: f64) -> RGBColor {
 }
 
 /// Render into an RGB buffer with `draw`, then PNG-encode and write atomically.
-fn render_png<F>(path: &Path, size: (u32, u32), background: Option<&[u8]>, draw: F) -> Result<()>
+pub(crate) fn render_png<F>(path: &Path, size: (u32, u32), background: Option<&[u8]>, draw: F) -> Result<()>
 where
     F: FnOnce(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
 {
@@ -137,7 +137,7 @@ where
     lbdem_core::atomic::write_atomic(path, &png).with_context(|| format!("cannot write {}", path.display()))
 }
 
-fn de<E: std::fmt::Display>(e: E) -> anyhow::Error {
+pub(crate) fn de<E: std::fmt::Display>(e: E) -> anyhow::Error {
     anyhow::anyhow!("plot drawing failed: {e}")
 }
 

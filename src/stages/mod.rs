@@ -3,10 +3,17 @@
 //! [`crate::contract::Stage`] and is listed once in [`crate::registry::STAGES`]. Stages know the
 //! kernels only through their public APIs, and never call the runner or the CLI.
 
+pub mod analyse;
 pub mod assemble;
+pub mod compare;
 pub mod digitise;
+pub mod matrix;
+pub mod mechanism_map;
 pub mod radiograph;
 pub mod report;
+pub mod run_data;
 pub mod settling_study;
 pub mod simulate;
+pub mod strain_fields;
 pub mod synth;
+pub mod synth_run;

@@ -355,7 +355,7 @@ mod tests {
         assert!(html.contains("T &amp; co"));
         // minijinja escapes "/" as &#x2f; in attributes (OWASP rule); browsers decode it.
         assert!(html.contains(r#"src="first&#x2f;m.png""#), "{html}");
-        assert!(html.contains("map &lt;script&gt;") && !html.contains("<script>"));
+        assert!(html.contains("map &lt;script&gt;") && !html.contains("map <script>"));
         assert!(html.contains("thick &lt;wedge&gt; departs"));
         assert!(html.contains("0.375"));
         assert!(html.contains(r#"href="first&#x2f;p.csv""#) && html.contains("<td>0.25</td>"));

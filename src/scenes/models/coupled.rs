@@ -221,6 +221,22 @@ impl<T: Real> CoupledModel<T> {
             .collect()
     }
 
+    /// Position (m) of the liquid node with the lowest Δp (the first of equals), NaN without liquid.
+    fn dp_min_site(&self, dp: &[f64]) -> [f64; 2] {
+        let nx = self.su.n[0].max(1);
+        let dx = self.run.units.dx();
+        dp.iter()
+            .enumerate()
+            .filter(|(_, p)| p.is_finite())
+            .min_by(|a, b| a.1.total_cmp(b.1).then(a.0.cmp(&b.0)))
+            .map_or([f64::NAN; 2], |(k, _)| {
+                [
+                    self.su.lo[0] + ((k % nx) as f64 + 0.5) * dx,
+                    self.su.lo[1] + ((k / nx) as f64 + 0.5) * dx,
+                ]
+            })
+    }
+
     /// Mean liquid speed over the active nodes (m/s) and the largest speed in lattice units
     /// (for the Mach number, Su Eq. 16).
     fn liquid_speeds(&self) -> (f64, f64) {
@@ -293,6 +309,8 @@ impl<T: Real> Model for CoupledModel<T> {
             .map(String::from),
         );
         c.extend(MASS_COLUMNS.map(String::from));
+        // Where Δp_min sits (m): the cracking site of Su Sect. 3.5 (issue 14's analysis).
+        c.extend(["dp_min_x", "dp_min_y"].map(String::from));
         if self.cell.is_some() {
             c.extend(shear_cell::COLUMNS.map(String::from));
         }
@@ -333,6 +351,7 @@ impl<T: Real> Model for CoupledModel<T> {
             self.lattice_mass_to_si(zm.removed),
             self.lattice_mass_to_si(zm.added),
         ]);
+        v.extend(self.dp_min_site(&dp));
         if let Some(c) = &self.cell {
             v.extend(c.sample(&run.sys, run.dem_stepper()));
         }
