@@ -135,3 +135,69 @@ fn a_scene_extends_another_key_by_key_and_loops_are_refused() {
     );
     assert!(e.contains("gone.toml"), "{e}");
 }
+
+/// Every Su 2020 case scene parses, and where its assembly is in the repository
+/// (`scenes/su2020/assemblies/NAME/`, built by `lbdem assemble`) its grains load: the file's
+/// grain set is the one the scene names (Table 2's count and sizes), the scene's walls and
+/// membrane go on them, and the coupled case builds (lattice, τ, step ratio). The assemblies listed here must exist: a missing one fails.
+#[test]
+fn the_su2020_cases_load_their_committed_assemblies() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/su2020");
+    let committed = ["pk81", "pk84", "pk93", "pk95", "sim1", "sim2", "sim3", "float"];
+    let (mut built, mut refused) = (0, Vec::new());
+    for e in std::fs::read_dir(&dir).unwrap().flatten() {
+        let p = e.path();
+        // `shear-base.toml` is what the cases extend, not a case.
+        if p.extension().is_none_or(|x| x != "toml") || p.to_string_lossy().ends_with("-base.toml") {
+            continue;
+        }
+        let l = load(&p, &Default::default()).unwrap_or_else(|e| panic!("{}: {e:#}", p.display()));
+        let Some(a) = l.scene.particles.as_ref().and_then(|pc| pc.assembly.as_ref()) else {
+            continue;
+        };
+        let case = a
+            .file
+            .parent()
+            .unwrap()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .to_string();
+        if !committed.contains(&case.as_str()) {
+            continue;
+        }
+        // The whole coupled case as `lbdem simulate` builds it: grains, walls, membrane, the
+        // lattice on the box (its faces on whole spacings), τ and the LBM-DEM ratio.
+        // Fig. 11's dry cases are the grains alone.
+        let built_case = if l.physics == Physics::Coupled {
+            crate::scenes::models::coupled::build_f64(&l.scene, &l.base_dir).map(|m| m.run.sys)
+        } else {
+            crate::scenes::build::dem::build_system(&l.scene, &l.base_dir)
+        };
+        let sys = match built_case {
+            Ok(sys) => sys,
+            Err(e) => {
+                refused.push(format!("{}: {e:#}", p.display()));
+                continue;
+            }
+        };
+        // A deleting %PK recipe may drop grains (81 %PK: 5083 -> 5000), never add them.
+        assert!(
+            sys.bodies.len() <= a.grains && sys.bodies.len() > a.grains * 9 / 10,
+            "{}: {} grains from an assembly of {}",
+            p.display(),
+            sys.bodies.len(),
+            a.grains
+        );
+        assert_eq!(
+            sys.membrane.as_ref().is_some_and(|m| !m.bodies.is_empty()),
+            l.scene.membrane.is_some(),
+            "{}: a [membrane] section and membrane grains go together",
+            p.display()
+        );
+        built += 1;
+    }
+    assert!(refused.is_empty(), "{}", refused.join("\n"));
+    // sim1, sim1-quick, sim2, sim3, 12 matrix cases, 6 Fig. 11 cases (84 %PK), float.
+    assert!(built >= 23, "only {built} Su cases built their grains");
+}
