@@ -1,5 +1,6 @@
 //! The real photograph of issue 5: touching bidisperse photoelastic disks in a box
-//! (PeGS test data set, J. Kollmer, `shared/data/real/pegs-photoelastic-disks/`). The box
+//! (PeGS test data set, J. Kollmer, `data/real/pegs-photoelastic-disks/`, licence and citation in
+//! data/real/README.md). The box
 //! is detected from the image, the disks inside it are found and split, the two size
 //! classes come apart, and no fitted circle lies outside the container.
 //!
@@ -11,15 +12,15 @@ use std::path::Path;
 
 const PHOTO: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../shared/data/real/pegs-photoelastic-disks/Step09-0001.jpg"
+    "/data/real/pegs-photoelastic-disks/Step09-0001.jpg"
 );
 
 #[test]
 fn finds_the_disks_in_the_box_and_their_two_sizes() {
-    if !Path::new(PHOTO).is_file() {
-        eprintln!("skipped: {PHOTO} not found (clone shared/ beside the repository)");
-        return;
-    }
+    assert!(
+        Path::new(PHOTO).is_file(),
+        "{PHOTO} is missing: the repository ships it"
+    );
     let dir = tempfile::tempdir().unwrap();
     let params = format!(
         "image = \"{PHOTO}\"\npixel_size_m = 1e-4\ncontainer = {{ kind = \"auto-box\" }}\nsmooth_px = 2.0\n\

@@ -1,22 +1,20 @@
-//! The `radiograph` stage on real data (/work/shared/data/real, see its README): the
+//! The `radiograph` stage on real data (data/real, see its README for licences and citations): the
 //! WaterInSand neutron step-wedge (16-bit, dark + open-beam correction, dose normalisation
 //! on an open region, gamma spots) and the ADIC wood-swelling pair (deflate float32 with
-//! NaN masks). Skipped with a message when the data directory is absent.
+//! NaN masks). The data ship with the repository; a missing file fails the test.
 
 use lbdem::contract::{Stage, StageContext};
 use lbdem::stages::radiograph::{Params, Radiograph};
 use std::path::{Path, PathBuf};
 
-fn real(sub: &str) -> Option<PathBuf> {
-    let c = [
-        format!("{}/../shared/data/real/{sub}", env!("CARGO_MANIFEST_DIR")),
-        format!("{}/../../shared/data/real/{sub}", env!("CARGO_MANIFEST_DIR")),
-    ];
-    let found = c.iter().map(PathBuf::from).find(|p| p.is_dir());
-    if found.is_none() {
-        println!("skipped: none of {c:?} exists (CI puts shared/ beside the clone)");
-    }
-    found
+fn real(sub: &str) -> PathBuf {
+    let d = PathBuf::from(format!("{}/data/real/{sub}", env!("CARGO_MANIFEST_DIR")));
+    assert!(
+        d.is_dir(),
+        "{} is missing: the repository ships it (git checkout data/real)",
+        d.display()
+    );
+    d
 }
 
 fn run(dir: &Path, text: &str) -> (serde_json::Value, tempfile::TempDir) {
@@ -29,9 +27,7 @@ fn run(dir: &Path, text: &str) -> (serde_json::Value, tempfile::TempDir) {
 
 #[test]
 fn step_wedge_with_dark_flat_dose_and_gamma_spots() {
-    let Some(dir) = real("waterinsand-stepwedge") else {
-        return;
-    };
+    let dir = real("waterinsand-stepwedge");
     // "Solid" = empty wedge (I_S^0 over the thin wedge's 0.5 mm step region of frame 0 is
     // meaningless for water; here the references are values so the stage runs end to end).
     let (s, _out) = run(
@@ -76,9 +72,7 @@ fn step_wedge_with_dark_flat_dose_and_gamma_spots() {
 
 #[test]
 fn wood_pair_float32_deflate_with_nan_masks() {
-    let Some(dir) = real("adic-neutron-wood-swelling") else {
-        return;
-    };
+    let dir = real("adic-neutron-wood-swelling");
     // Transmissions already flat-field normalised; pixel size not stated upstream (100 um
     // assumed for the REV only). Reference "phases": earlywood-like and latewood-like levels.
     let (s, out) = run(

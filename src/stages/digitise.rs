@@ -10,7 +10,7 @@
 //! overlay of the fitted circles on the image. User guide: docs/digitise.md.
 
 mod export;
-mod load;
+pub mod load;
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::{plot, table};

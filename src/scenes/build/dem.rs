@@ -15,7 +15,11 @@ fn v(a: [f64; 2]) -> Vec2 {
 pub fn build_system(s: &Scene, base: &Path) -> Result<System> {
     let pc = s.particles.as_ref().context("the scene has no [particles]")?;
     let bodies = match (&pc.csv, &pc.generate) {
-        (Some(path), None) => particles_csv::read_csv(&base.join(path), pc.density)?,
+        (Some(path), None) => particles_csv::read_csv_in(
+            &base.join(path),
+            pc.density,
+            Some((s.domain.lo2(), s.domain.hi2())),
+        )?,
         (None, Some(g)) => {
             let shapes: Vec<ClumpShape<Vec2>> = g
                 .templates

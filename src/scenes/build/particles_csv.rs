@@ -4,7 +4,7 @@
 //! `{"units": "m" | "px", "pixel_size": metres per pixel}`. Without the header, metres.
 
 use anyhow::{Context, Result, bail};
-use lbdem_dem::{Ball, Bodies, ClumpShape, Vec2};
+use lbdem_dem::{Ball, Bodies, ClumpShape, Vec2, Vector};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -22,6 +22,12 @@ fn metres() -> String {
 }
 
 pub fn read_csv(path: &Path, density: f64) -> Result<Bodies> {
+    read_csv_in(path, density, None)
+}
+
+/// [`read_csv`], refusing a circle whose centre lies outside `domain` ([lo, hi] in m) with its
+/// line: a file in the wrong units or of another scene, caught before anything runs.
+pub fn read_csv_in(path: &Path, density: f64, domain: Option<([f64; 2], [f64; 2])>) -> Result<Bodies> {
     let newest;
     let path = if path.is_dir() {
         newest = newest_snapshot(path)?;
@@ -32,27 +38,64 @@ pub fn read_csv(path: &Path, density: f64) -> Result<Bodies> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read particle file {}", path.display()))?;
     let header_path = path.with_extension("json");
-    let scale = if header_path.exists() {
-        let h: Header = serde_json::from_str(
-            &std::fs::read_to_string(&header_path)
+    let header = if header_path.exists() {
+        Some(
+            std::fs::read_to_string(&header_path)
                 .with_context(|| format!("cannot read {}", header_path.display()))?,
         )
-        .with_context(|| {
-            format!(
-                "{}: expected {{\"units\": \"m\"|\"px\", \"pixel_size\": ...}}",
-                header_path.display()
-            )
-        })?;
-        match (h.units.as_str(), h.pixel_size) {
-            ("m", _) => 1.0,
-            ("px", Some(s)) if s > 0.0 => s,
-            (u, s) => bail!(
-                "{}: units = {u:?}, pixel_size = {s:?}; use units \"m\", or \"px\" with a positive pixel_size in metres",
-                header_path.display()
-            ),
-        }
     } else {
-        1.0
+        None
+    };
+    let rows = parse(&text, header.as_deref(), path)?;
+    if let Some((lo, hi)) = domain {
+        inside(&rows, lo, hi, path)?;
+    }
+    coincident(&rows, path)?;
+    let mut grains: BTreeMap<i64, Vec<Ball<Vec2>>> = BTreeMap::new();
+    for r in rows {
+        grains.entry(r.grain).or_default().push(r.ball);
+    }
+    let mut bodies = Bodies::new();
+    for balls in grains.into_values() {
+        let shape = ClumpShape { balls };
+        let c = shape.mass_props().context("particle file")?.centroid;
+        bodies
+            .add(&shape, density, c, 0.0)
+            .with_context(|| format!("{}", path.display()))?;
+    }
+    Ok(bodies)
+}
+
+/// One circle of the file and the line (from 1) it came from.
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub line: usize,
+    pub grain: i64,
+    pub ball: Ball<Vec2>,
+}
+
+/// The circles of a particle file's `text` (`header`: the JSON beside it, if any), scaled to
+/// metres; every value checked (whole grain ids, finite positions, positive finite radii).
+pub fn parse(text: &str, header: Option<&str>, path: &Path) -> Result<Vec<Row>> {
+    let header_path = path.with_extension("json");
+    let scale = match header {
+        Some(json) => {
+            let h: Header = serde_json::from_str(json).with_context(|| {
+                format!(
+                    "{}: expected {{\"units\": \"m\"|\"px\", \"pixel_size\": ...}}",
+                    header_path.display()
+                )
+            })?;
+            match (h.units.as_str(), h.pixel_size) {
+                ("m", _) => 1.0,
+                ("px", Some(s)) if s > 0.0 && s.is_finite() => s,
+                (u, s) => bail!(
+                    "{}: units = {u:?}, pixel_size = {s:?}; use units \"m\", or \"px\" with a positive pixel_size in metres",
+                    header_path.display()
+                ),
+            }
+        }
+        None => 1.0,
     };
     let mut lines = text
         .lines()
@@ -77,42 +120,107 @@ pub fn read_csv(path: &Path, density: f64) -> Result<Bodies> {
         _ => idx("grain_id")?,
     };
     let (ix, iy, ir) = (idx("x")?, idx("y")?, idx("r")?);
-    let mut grains: BTreeMap<i64, Vec<Ball<Vec2>>> = BTreeMap::new();
+    let mut rows = Vec::new();
     for (ln, line) in lines {
         let f: Vec<&str> = line.split(',').map(str::trim).collect();
+        let at = || format!("{} line {}", path.display(), ln + 1);
         let num = |k: usize, name: &str| -> Result<f64> {
-            f.get(k).and_then(|s| s.parse::<f64>().ok()).with_context(|| {
-                format!(
-                    "{} line {}: column {name} is missing or not a number in {line:?}",
-                    path.display(),
-                    ln + 1
-                )
-            })
+            let v = f
+                .get(k)
+                .and_then(|s| s.parse::<f64>().ok())
+                .with_context(|| format!("{}: column {name} is missing or not a number in {line:?}", at()))?;
+            if !v.is_finite() {
+                bail!(
+                    "{}: {name} = {v}: every value must be a finite number; fix the row",
+                    at()
+                );
+            }
+            Ok(v)
         };
-        let g = num(ig, "grain_id")? as i64;
+        let g = num(ig, "grain_id")?;
+        if g.fract() != 0.0 || g.abs() > 9.0e15 {
+            bail!(
+                "{}: grain_id = {g} is not a whole number; grain ids are integers (rows of one grain share one)",
+                at()
+            );
+        }
         let ball = Ball {
             centre: Vec2::new(num(ix, "x")? * scale, num(iy, "y")? * scale),
             r: num(ir, "r")? * scale,
         };
-        if ball.r.is_nan() || ball.r <= 0.0 {
+        if !(ball.r > 0.0 && ball.r.is_finite()) {
+            bail!("{}: r = {} must be positive", at(), ball.r);
+        }
+        rows.push(Row {
+            line: ln + 1,
+            grain: g as i64,
+            ball,
+        });
+    }
+    Ok(rows)
+}
+
+/// Refuse a circle whose centre lies outside [lo, hi] (a radius larger than the box is a file
+/// in other units).
+fn inside(rows: &[Row], lo: [f64; 2], hi: [f64; 2], path: &Path) -> Result<()> {
+    let side = (hi[0] - lo[0]).min(hi[1] - lo[1]);
+    for r in rows {
+        let c = r.ball.centre;
+        if c.x < lo[0] || c.x > hi[0] || c.y < lo[1] || c.y > hi[1] {
             bail!(
-                "{} line {}: r = {} must be positive",
+                "{} line {}: the circle at ({}, {}) m lies outside the [domain] box [{}, {}] x [{}, {}] m; \
+                 is the file in other units (give NAME.json with \"units\": \"px\" and the pixel_size) or of \
+                 another scene? Move the circle inside or enlarge [domain]",
                 path.display(),
-                ln + 1,
-                ball.r
+                r.line,
+                c.x,
+                c.y,
+                lo[0],
+                hi[0],
+                lo[1],
+                hi[1]
             );
         }
-        grains.entry(g).or_default().push(ball);
+        if r.ball.r > 0.5 * side {
+            bail!(
+                "{} line {}: r = {} m is more than half the [domain] box ({side} m across); is the file in \
+                 other units (mm or pixels: give NAME.json with \"units\": \"px\" and the pixel_size)?",
+                path.display(),
+                r.line,
+                r.ball.r
+            );
+        }
     }
-    let mut bodies = Bodies::new();
-    for balls in grains.into_values() {
-        let shape = ClumpShape { balls };
-        let c = shape.mass_props().context("particle file")?.centroid;
-        bodies
-            .add(&shape, density, c, 0.0)
-            .with_context(|| format!("{}", path.display()))?;
+    Ok(())
+}
+
+/// Refuse two circles of different grains with the same centre (their contact has no normal:
+/// the first step would be NaN).
+fn coincident(rows: &[Row], path: &Path) -> Result<()> {
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    order.sort_by(|&a, &b| rows[a].ball.centre.x.total_cmp(&rows[b].ball.centre.x));
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            let (p, q) = (&rows[a], &rows[b]);
+            let tol = 1e-9 * (p.ball.r + q.ball.r);
+            if q.ball.centre.x - p.ball.centre.x > tol {
+                break;
+            }
+            if p.grain != q.grain && (q.ball.centre - p.ball.centre).norm() <= tol {
+                let (first, second) = (p.line.min(q.line), p.line.max(q.line));
+                bail!(
+                    "{} lines {first} and {second}: circles of grains {} and {} have the same centre ({}, {}) m; \
+                     two grains cannot sit on one point (their contact has no direction): remove or move one",
+                    path.display(),
+                    p.grain.min(q.grain),
+                    p.grain.max(q.grain),
+                    p.ball.centre.x,
+                    p.ball.centre.y
+                );
+            }
+        }
     }
-    Ok(bodies)
+    Ok(())
 }
 
 /// The newest particle snapshot (`particles_<step>.csv`, highest step) in a run's snapshot

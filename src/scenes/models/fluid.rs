@@ -87,8 +87,8 @@ fn geometry(s: &Scene, su: &LatticeSetup, base: &Path) -> Result<Geometry> {
                 bail!("[mask] images are 2D; use [[obstacles]] spheres in 3D");
             }
             let path = base.join(&m.image);
-            let img = image::open(&path)
-                .with_context(|| format!("[mask] cannot read image {}", path.display()))?
+            let img = crate::io::image::open(&path)
+                .with_context(|| format!("[mask] image = {:?}", m.image))?
                 .to_luma8();
             if img.width() as usize != n[0] || img.height() as usize != n[1] {
                 bail!(
