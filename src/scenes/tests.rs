@@ -71,5 +71,6 @@ mod coupled;
 mod dry;
 mod float;
 mod fluid;
+mod initial;
 mod schema;
 mod shear_cell;

@@ -115,6 +115,11 @@ const RULES: &[Rule] = &[
         "factor on every grain's area (Su Float: 0.9)",
     ),
     Rule("particles.generate.count", Need::Positive, "number of grains"),
+    Rule(
+        "particles.velocity",
+        Need::Len(2),
+        "initial grain velocity [vx, vy] (m/s)",
+    ),
     Rule("particles.generate.lo", Need::Len(2), "lower corner [x, y] (m)"),
     Rule("particles.generate.hi", Need::Len(2), "upper corner [x, y] (m)"),
     Rule(
@@ -427,6 +432,15 @@ pub fn consistency(s: &super::Scene) -> Result<()> {
                 );
             }
         }
+    }
+    if let Some(p) = &s.particles
+        && (p.velocity.is_some() || p.omega.is_some())
+        && s.compress.is_some()
+    {
+        bail!(
+            "[particles] velocity / omega and [compress]: the compression brings the grains to rest before \
+             the run, so an initial velocity would be lost; remove one of them"
+        );
     }
     if let Some(l) = &s.lattice
         && l.mach_warn > l.mach_max
