@@ -616,6 +616,27 @@ fn read_snapshots(bytes: &[u8]) -> bool {
     a || b || c
 }
 
+fn initial_fluid_seeds() -> Vec<Vec<u8>> {
+    let mut t = String::from("i,j,k,x,y,z,ux,uy,uz,pressure\n");
+    for j in 0..4 {
+        for i in 0..4 {
+            t.push_str(&format!("{i},{j},0,0,0,0,0.01,-0.02,0,{}\n", i as f64 - 1.5));
+        }
+    }
+    vec![t.into_bytes()]
+}
+
+/// `[fluid] initial` on a 4 x 4 lattice with one solid node: the table's checks.
+fn read_initial_fluid(bytes: &[u8]) -> bool {
+    use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
+    let p = write_scratch("initial.csv", bytes);
+    let units =
+        LatticeUnits::derive(&LatticeInput::new(0.01, 1e-3, 1000.0, 0.1, TimeSpec::Tau(0.8))).unwrap();
+    let mut kind = vec![lbdem_lbm::domain::FLUID; 16];
+    kind[5] = lbdem_lbm::domain::SOLID;
+    lbdem::scenes::build::initial_fluid::read(&p, [4, 4, 1], 2, &kind, &units, 0.1).is_ok()
+}
+
 /// The small dry scene as a model, ready to restore a checkpoint into.
 fn dry_model() -> Box<dyn lbdem::scenes::timeloop::Model> {
     let p = scratch().join("model.toml");
@@ -671,4 +692,5 @@ targets! {
     particle_header_json: 100_000, header_seeds(), text_bound, read_particles_header;
     snapshot_tables: 2_000, snapshot_seeds(), text_bound, read_snapshots;
     checkpoint_json: 2_000, checkpoint_seeds(), text_bound, restore_checkpoint;
+    fluid_initial: 5_000, initial_fluid_seeds(), text_bound, read_initial_fluid;
 }

@@ -72,5 +72,6 @@ mod dry;
 mod float;
 mod fluid;
 mod initial;
+mod initial_fluid;
 mod schema;
 mod shear_cell;

@@ -3,5 +3,6 @@
 //! same way in a dry and in a coupled scene.
 
 pub mod dem;
+pub mod initial_fluid;
 pub mod lattice;
 pub mod particles_csv;

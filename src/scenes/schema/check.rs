@@ -442,6 +442,19 @@ pub fn consistency(s: &super::Scene) -> Result<()> {
              the run, so an initial velocity would be lost; remove one of them"
         );
     }
+    if let Some(f) = &s.fluid
+        && f.initial.is_some()
+        && s.particles.is_some()
+    {
+        bail!(
+            "[fluid] initial = {:?} in a scene with grains: an initial liquid field is read for liquid-only \
+             scenes so far; remove it, or start the coupled run from rest",
+            f.initial
+                .as_ref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default()
+        );
+    }
     if let Some(l) = &s.lattice
         && l.mach_warn > l.mach_max
     {
