@@ -9,4 +9,4 @@ cd "$(dirname "$0")/.."
 n="${1:-1000000}"
 shift || true
 export LBDEM_FUZZ_EXECS="$n"
-cargo test --release --test fuzz -- --nocapture --test-threads 1 "$@" 2>&1 | grep -E "^fuzz |test result|panicked|FAILED"
+cargo test --release --test fuzz -- --nocapture --test-threads 1 "$@" 2>&1 | grep -oE "fuzz [a-z_]+: .*|test result.*|panicked.*|FAILED.*"
