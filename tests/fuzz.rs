@@ -688,7 +688,7 @@ targets! {
     set_overrides: 10_000, override_seeds(), text_bound, apply_overrides;
     pipeline_toml: 50_000, pipeline_seeds(), text_bound, parse_pipeline;
     stage_params: 50_000, params_seeds(), text_bound, prepare_params;
-    particle_csv: 20_000, particle_seeds(), text_bound, read_particles_csv;
+    particle_csv: 10_000, particle_seeds(), text_bound, read_particles_csv;
     particle_header_json: 100_000, header_seeds(), text_bound, read_particles_header;
     snapshot_tables: 2_000, snapshot_seeds(), text_bound, read_snapshots;
     checkpoint_json: 2_000, checkpoint_seeds(), text_bound, restore_checkpoint;

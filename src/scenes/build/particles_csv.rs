@@ -5,6 +5,7 @@
 
 use anyhow::{Context, Result, bail};
 use lbdem_dem::{Ball, Bodies, ClumpShape, Vec2, Vector};
+use polars::prelude::{CsvReadOptions, DataType, SerReader};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -97,16 +98,37 @@ pub fn parse(text: &str, header: Option<&str>, path: &Path) -> Result<Vec<Row>> 
         }
         None => 1.0,
     };
-    let mut lines = text
+    // Comment and blank lines out, so that data row k of the table is `lines[k + 1]` (the line
+    // numbers of the messages); polars reads the table, every cell as text, and each value is
+    // checked here with its line.
+    let lines: Vec<(usize, &str)> = text
         .lines()
         .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
-    let (_, head) = lines
-        .next()
-        .with_context(|| format!("{}: empty file; expected a header grain_id,x,y,r", path.display()))?;
-    let cols: Vec<&str> = head.split(',').map(str::trim).collect();
+        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'))
+        .collect();
+    let Some(&(_, head)) = lines.first() else {
+        bail!("{}: empty file; expected a header grain_id,x,y,r", path.display());
+    };
+    let clean: String = lines.iter().flat_map(|(_, l)| [*l, "\n"]).collect();
+    let df = CsvReadOptions::default()
+        .with_has_header(true)
+        .with_infer_schema_length(Some(0))
+        .map_parse_options(|o| o.with_truncate_ragged_lines(true).with_missing_is_null(true))
+        .into_reader_with_file_handle(std::io::Cursor::new(clean.as_bytes()))
+        .finish()
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "{}: not a CSV table with a header grain_id,x,y,r: {e}",
+                path.display()
+            )
+        })?;
+    let cols: Vec<String> = df
+        .get_column_names()
+        .iter()
+        .map(|c| c.trim().to_string())
+        .collect();
     let idx = |name: &str| {
-        cols.iter().position(|c| *c == name).with_context(|| {
+        cols.iter().position(|c| c == name).with_context(|| {
             format!(
                 "{}: header {head:?} has no column {name:?}; need grain_id,x,y,r",
                 path.display()
@@ -115,18 +137,24 @@ pub fn parse(text: &str, header: Option<&str>, path: &Path) -> Result<Vec<Row>> 
     };
     // A particle snapshot of a run (`body,circle,...,x,y,r,...`) reads back too: its `body`
     // column is the grain id.
-    let ig = match cols.iter().position(|c| *c == "body") {
-        Some(k) if !cols.contains(&"grain_id") => k,
+    let ig = match cols.iter().position(|c| c == "body") {
+        Some(k) if !cols.iter().any(|c| c == "grain_id") => k,
         _ => idx("grain_id")?,
     };
     let (ix, iy, ir) = (idx("x")?, idx("y")?, idx("r")?);
+    let text_col = |k: usize| -> Result<Vec<Option<String>>> {
+        let c = df.columns()[k].cast(&DataType::String)?;
+        Ok(c.str()?.iter().map(|v| v.map(|s| s.trim().to_string())).collect())
+    };
+    let [g_col, x_col, y_col, r_col] = [ig, ix, iy, ir].map(text_col);
+    let (g_col, x_col, y_col, r_col) = (g_col?, x_col?, y_col?, r_col?);
     let mut rows = Vec::new();
-    for (ln, line) in lines {
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
+    for row in 0..df.height() {
+        let (ln, line) = lines[row + 1];
         let at = || format!("{} line {}", path.display(), ln + 1);
-        let num = |k: usize, name: &str| -> Result<f64> {
-            let v = f
-                .get(k)
+        let num = |col: &[Option<String>], name: &str| -> Result<f64> {
+            let v = col[row]
+                .as_deref()
                 .and_then(|s| s.parse::<f64>().ok())
                 .with_context(|| format!("{}: column {name} is missing or not a number in {line:?}", at()))?;
             if !v.is_finite() {
@@ -137,7 +165,7 @@ pub fn parse(text: &str, header: Option<&str>, path: &Path) -> Result<Vec<Row>> 
             }
             Ok(v)
         };
-        let g = num(ig, "grain_id")?;
+        let g = num(&g_col, "grain_id")?;
         if g.fract() != 0.0 || g.abs() > 9.0e15 {
             bail!(
                 "{}: grain_id = {g} is not a whole number; grain ids are integers (rows of one grain share one)",
@@ -145,8 +173,8 @@ pub fn parse(text: &str, header: Option<&str>, path: &Path) -> Result<Vec<Row>> 
             );
         }
         let ball = Ball {
-            centre: Vec2::new(num(ix, "x")? * scale, num(iy, "y")? * scale),
-            r: num(ir, "r")? * scale,
+            centre: Vec2::new(num(&x_col, "x")? * scale, num(&y_col, "y")? * scale),
+            r: num(&r_col, "r")? * scale,
         };
         if !(ball.r > 0.0 && ball.r.is_finite()) {
             bail!("{}: r = {} must be positive", at(), ball.r);
