@@ -50,6 +50,7 @@ selected() {
 }
 
 version=$(git describe --always --dirty 2>/dev/null || echo unknown)
+commit=$(git rev-parse HEAD 2>/dev/null || echo unknown)
 stamp=$(date -u +%Y-%m-%d)
 dir="reports/validation/$stamp-$version"
 table="| id | figure | reference | tolerance | pass | wall (s) |\n|---|---|---|---|---|---|\n"
@@ -96,7 +97,7 @@ fi
 {
   echo "# Validation run $stamp"
   echo
-  echo "- code version: $version ($(git rev-parse HEAD 2>/dev/null || echo unknown))"
+  echo "- code version: $version ($commit, at the start of the run)"
   echo "- command: scripts/validate-all.sh ${filters[*]:-}"
   echo "- machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), load at the end $(cut -d' ' -f1 /proc/loadavg)"
   echo "- $ran run, $failed failed or not run; each test's output in logs/"
