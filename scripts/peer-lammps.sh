@@ -7,17 +7,16 @@
 # (lammps_2d_prep.in, 45,000 steps on 2 ranks: ~1 min for 10,000 disks, ~10-20 min for 100,000).
 #
 # Usage: scripts/peer-lammps.sh N_SIDE NP NSTEPS     (N = N_SIDE^2 disks; 100 -> 10,000; 316 -> 99,856)
-# Decks: lammps_2d_prep.in / lammps_2d.in from $LBDEM_PEERS, else ../shared/peers or ../../shared/peers
-# relative to the repository. The prepared packing is cached in out/peer-lammps/.
+# Decks: lammps_2d_prep.in / lammps_2d.in from $LBDEM_PEERS, else scripts/peers/. The prepared packing is cached in out/peer-lammps/.
 set -euo pipefail
 n="${1:-100}"; np="${2:-1}"; nsteps="${3:-20000}"
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 peers="${LBDEM_PEERS:-}"
-for cand in "$peers" "$repo/../shared/peers" "$repo/../../shared/peers"; do
+for cand in "$peers" "$repo/scripts/peers"; do
     if [ -n "$cand" ] && [ -f "$cand/lammps_2d.in" ]; then peers="$(cd "$cand" && pwd)"; break; fi
 done
 if [ ! -f "$peers/lammps_2d.in" ]; then
-    echo "peer-lammps: cannot find lammps_2d.in; set LBDEM_PEERS to the shared peers/ directory" >&2; exit 2
+    echo "peer-lammps: cannot find lammps_2d.in; set LBDEM_PEERS to a directory holding the decks" >&2; exit 2
 fi
 if ! command -v lmp >/dev/null 2>&1; then
     echo "peer-lammps: installing Debian lammps" >&2

@@ -9,18 +9,12 @@
 #   `scripts/peer-lbmpy.sh install` only creates the venv.
 # Prints one JSON line (lbmpy_bench.py's output, field "median" = MLUPS).
 # The venv lives in target/peer-lbmpy-venv (git-ignored, next to the build); lbmpy and pystencils
-# come from PyPI by name and pinned version. The driver is the shared peer script
-# ../shared/peers/lbmpy_bench.py (relative to the repository root), override with LBMPY_BENCH=path.
+# come from PyPI by name and pinned version. The driver is scripts/peers/lbmpy_bench.py, override
+# with LBMPY_BENCH=path.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENV="${LBMPY_VENV:-$ROOT/target/peer-lbmpy-venv}"
-# ../shared/peers from the main checkout (/work/main); ../../shared/peers from a worktree (/work/wt/x)
-BENCH="${LBMPY_BENCH:-}"
-if [ -z "$BENCH" ]; then
-    for d in "$ROOT/../shared/peers" "$ROOT/../../shared/peers"; do
-        if [ -f "$d/lbmpy_bench.py" ]; then BENCH="$d/lbmpy_bench.py"; break; fi
-    done
-fi
+BENCH="${LBMPY_BENCH:-$ROOT/scripts/peers/lbmpy_bench.py}"
 PY="$VENV/bin/python"
 
 install() {
@@ -36,7 +30,7 @@ if [ $# -lt 3 ]; then
     echo "usage: $0 SIZE DTYPE THREADS [VARIANT]   or   $0 install" >&2
     exit 2
 fi
-[ -n "$BENCH" ] && [ -f "$BENCH" ] || { echo "peer-lbmpy: driver lbmpy_bench.py not found in ../shared/peers or ../../shared/peers; set LBMPY_BENCH=path" >&2; exit 2; }
+[ -n "$BENCH" ] && [ -f "$BENCH" ] || { echo "peer-lbmpy: driver $BENCH not found; set LBMPY_BENCH=path" >&2; exit 2; }
 install
 SIZE="$1" DTYPE="$2" THREADS="$3" VARIANT="${4:-aa}"
 # threads pinned to cores unless the caller says otherwise (OMP_PROC_BIND=false lets the OS move a

@@ -74,14 +74,34 @@ fn cli_writes_the_assembly_with_its_header() {
         "no circle near the top grain's y = {y_top_m}"
     );
     // Mean diameter in metres within 3 % of the truth.
-    let stage: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("stage.json")).unwrap_or_default())
-            .unwrap_or(serde_json::Value::Null);
     let d_true = s.grains.iter().map(|g| g.d_eq_px).sum::<f64>() / s.grains.len() as f64 * px;
     let d_bar = header["d_bar_m"].as_f64().unwrap();
     assert!(
         (d_bar - d_true).abs() / d_true < 0.03,
         "d_bar {d_bar} vs {d_true}"
     );
-    let _ = stage;
+    // The manifest records what ran, with what, and what it found and wrote.
+    let stage: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("stage.json")).unwrap()).unwrap();
+    assert_eq!(stage["kind"], "digitise");
+    assert_eq!(stage["params"]["pixel_size_m"].as_f64(), Some(px));
+    assert_eq!(
+        stage["output"]["summary"]["n_grains"].as_u64(),
+        Some(n_grains as u64)
+    );
+    let files: Vec<&str> = stage["output"]["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f.as_str())
+        .collect();
+    for f in ["particles.csv", "particles.json", "overlay.png"] {
+        assert!(files.contains(&f), "stage.json does not list {f}: {files:?}");
+    }
+    assert_eq!(
+        stage["inputs"][0]["sha256"].as_str().map(str::len),
+        Some(64),
+        "{}",
+        stage["inputs"]
+    );
 }

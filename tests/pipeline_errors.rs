@@ -41,3 +41,35 @@ fn bad_parameters_of_a_late_stage_fail_before_anything_runs() {
     assert!(err.contains("r2") && err.contains("titel"), "{err}");
     assert!(!out.exists(), "a stage ran before the pipeline was checked");
 }
+
+/// Regression (issue 17): a pipeline whose first stage fails at run time (its parameters parse,
+/// but a region lies outside the image) left an empty output directory.
+#[test]
+fn a_pipeline_failing_in_its_first_stage_leaves_no_output_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let repo = env!("CARGO_MANIFEST_DIR");
+    let text = std::fs::read_to_string(format!("{repo}/pipelines/quickstart.toml"))
+        .unwrap()
+        .replace("root = \"..\"", &format!("root = \"{repo}\""))
+        .replace(
+            "out = \"reports/quickstart\"",
+            &format!("out = \"{}\"", out.display()),
+        )
+        .replace("i_s0_roi = [16, 8, 480, 32]", "i_s0_roi = [16, 8, 4800, 32]");
+    let path = dir.path().join("p.toml");
+    std::fs::write(&path, text).unwrap();
+    let (ok, err) = run(&["run", path.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("i_s0_roi") && err.contains("outside"), "{err}");
+    assert!(!out.exists(), "a failed pipeline left {}", out.display());
+}
+
+/// Regression (issue 17): `bench radiograph --reps 0` exited 0 and printed a rate as the
+/// "median of 0" runs.
+#[test]
+fn a_benchmark_of_zero_repetitions_is_refused() {
+    let (ok, err) = run(&["bench", "radiograph", "--reps", "0"]);
+    assert!(!ok, "{err}");
+    assert!(err.contains("--reps") && err.contains("at least 1"), "{err}");
+}

@@ -137,3 +137,84 @@ fn equal_reference_intensities_are_refused() {
     );
     assert_eq!(std::fs::read_dir(out.path()).unwrap().count(), 0);
 }
+
+/// A 300-byte little-endian TIFF whose header claims `w` x `h` 16-bit grey pixels in one
+/// uncompressed strip (the pixel data is absent).
+fn hostile_tiff(w: u32, h: u32) -> Vec<u8> {
+    // (tag, type: 3 = SHORT, 4 = LONG, value)
+    let entries: [(u16, u16, u32); 9] = [
+        (256, 4, w),   // ImageWidth
+        (257, 4, h),   // ImageLength
+        (258, 3, 16),  // BitsPerSample
+        (259, 3, 1),   // Compression: none
+        (262, 3, 1),   // PhotometricInterpretation: black is zero
+        (273, 4, 8),   // StripOffsets
+        (277, 3, 1),   // SamplesPerPixel
+        (278, 4, h),   // RowsPerStrip
+        (279, 4, 200), // StripByteCounts
+    ];
+    let mut b = b"II*\0".to_vec();
+    b.extend(8u32.to_le_bytes());
+    b.extend((entries.len() as u16).to_le_bytes());
+    for (tag, ty, v) in entries {
+        b.extend(tag.to_le_bytes());
+        b.extend(ty.to_le_bytes());
+        b.extend(1u32.to_le_bytes());
+        match ty {
+            3 => b.extend((v as u16).to_le_bytes().into_iter().chain([0, 0])),
+            _ => b.extend(v.to_le_bytes()),
+        }
+    }
+    b.extend(0u32.to_le_bytes());
+    b.resize(300, 0);
+    b
+}
+
+/// Regression (issue 17): a 300-byte TIFF claiming 200000 x 200000 pixels made `lbdem
+/// radiograph` allocate 80 GB and abort (exit 134), leaving a staging directory behind. Now the
+/// header is checked against the per-frame limit before anything is allocated: exit 1, the
+/// file and the limit named, and the output directory not created.
+#[test]
+fn a_header_claiming_80_gb_is_refused_without_allocating() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("huge.tif"), hostile_tiff(200_000, 200_000)).unwrap();
+    std::fs::write(
+        d.path().join("p.toml"),
+        "frames = [\"huge.tif\"]\ni_s0_roi = [0, 0, 4, 4]\ni_l0_roi = [4, 0, 4, 4]\nmu_s = 2000.0\n\
+         mu_l = 9000.0\nl_alloy0 = 150e-6\nd_bar = 10e-6\npixel_size = 1e-6\n",
+    )
+    .unwrap();
+    let out = d.path().join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lbdem"))
+        .args(["radiograph", "p.toml", "--out", "out"])
+        .current_dir(d.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "a refused file exits 1, not abort: {err}"
+    );
+    for needle in ["huge.tif", "200000 x 200000", "limit", "128 MiB"] {
+        assert!(err.contains(needle), "the error should name '{needle}': {err}");
+    }
+    assert!(
+        !out.exists(),
+        "nothing may be left behind: {:?}",
+        std::fs::read_dir(&out).map(|r| r.count())
+    );
+    // The reader alone, from bytes: the same refusal, and the limit is what a real frame needs.
+    let e = lbdem::io::tiff::read_pages_from(std::io::Cursor::new(hostile_tiff(200_000, 200_000)), "x")
+        .unwrap_err();
+    assert!(format!("{e:#}").contains("above lbdem's limit"), "{e:#}");
+    // Su's detector frame (2048 x 2048, 16 bits) reads under the limit.
+    let su = d.path().join("su.tif");
+    write_u16(&su, Array2::from_elem((2048, 2048), 1234u16).view()).unwrap();
+    let f = lbdem::io::tiff::read_pages(&su).unwrap();
+    assert_eq!((f[0].data.dim(), f[0].data[[2047, 2047]]), ((2048, 2048), 1234.0));
+    // 4096 x 4096 at 16 bits is under the limit: the header passes and the missing data is named.
+    let e =
+        lbdem::io::tiff::read_pages_from(std::io::Cursor::new(hostile_tiff(4096, 4096)), "x").unwrap_err();
+    assert!(format!("{e:#}").contains("cannot decode the pixel data"), "{e:#}");
+}

@@ -1,5 +1,5 @@
 //! Real neutron radiographs of a water step-wedge (WaterInSand, CC0; see
-//! /work/shared/data/real/README.md): after dark, open-beam and dose correction and
+//! data/real/README.md): after dark, open-beam and dose correction and
 //! gamma-spot removal, the water attenuation -ln(T_water / T_empty) of the thin wedge must
 //! be linear in the known water thickness 0.5-2.5 mm (Beer-Lambert, Su et al. 2020 Eq. 1's
 //! premise) with R^2 > 0.99. The thick wedge (3.0-5.0 mm) is fitted and its departure from
@@ -11,24 +11,23 @@ use lbdem_imaging::profile::linear_fit;
 use ndarray::{Array2, s};
 use std::path::Path;
 
-/// `shared/` beside the clone (CI), or two levels up for a git worktree under `wt/`.
-const CANDIDATES: [&str; 2] = [
-    concat!(
+/// The data, in the repository (data/real/README.md: licence and citation). A missing file is a
+/// failure: a test without its data proves nothing.
+fn dir() -> &'static Path {
+    let d = Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../shared/data/real/waterinsand-stepwedge"
-    ),
-    concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/data/real/waterinsand-stepwedge"
-    ),
-];
-
-fn dir() -> Option<&'static Path> {
-    CANDIDATES.iter().map(Path::new).find(|p| p.is_dir())
+        "/data/real/waterinsand-stepwedge"
+    ));
+    assert!(
+        d.is_dir(),
+        "{} is missing: the repository ships it (git checkout data/real)",
+        d.display()
+    );
+    d
 }
 
 fn load(name: &str) -> Array2<f64> {
-    let f = read_pages(&dir().unwrap().join(name)).unwrap().remove(0).data;
+    let f = read_pages(&dir().join(name)).unwrap().remove(0).data;
     correct::remove_gamma_spots(f.view(), 5, 6.0).unwrap().0
 }
 
@@ -37,11 +36,7 @@ const OPEN: [usize; 4] = [700, 300, 120, 400];
 
 /// Water attenuation map -ln(T_h2o / T_empty) with T = (I - D) / (OB - D), each frame
 /// dose-normalised on the open region.
-pub fn water_attenuation() -> Option<Array2<f64>> {
-    if dir().is_none() {
-        println!("skipped: none of {CANDIDATES:?} exists (CI puts shared/ beside the clone)");
-        return None;
-    }
+pub fn water_attenuation() -> Array2<f64> {
     let (ob, dc) = (load("exp10s_ob.tif"), load("exp10s_dc.tif"));
     let mut t_e = correct::flat_dark(load("exp10s_empty.tif").view(), Some(dc.view()), Some(ob.view()));
     let mut t_w = correct::flat_dark(load("exp10s_h2o.tif").view(), Some(dc.view()), Some(ob.view()));
@@ -53,7 +48,7 @@ pub fn water_attenuation() -> Option<Array2<f64>> {
         .and(&t_e)
         .and(&t_w)
         .for_each(|a, &e, &w| *a = -(w / e).ln());
-    Some(a)
+    a
 }
 
 /// Plateaus of the row profile of `a` over columns `x0..x1`: (first row, last row, median).
@@ -100,7 +95,7 @@ fn plateaus(a: &Array2<f64>, x0: usize, x1: usize, jump: f64) -> Vec<(usize, usi
 
 #[test]
 fn thin_wedge_attenuation_is_linear_in_water_thickness() {
-    let Some(a) = water_attenuation() else { return };
+    let a = water_attenuation();
     if let Ok(p) = std::env::var("LBDEM_DEBUG_PNG") {
         let opts = lbdem::report::plot::FieldPlot {
             title: "water attenuation -ln(T_h2o/T_empty)",

@@ -39,8 +39,8 @@ pub enum Which {
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
     pub which: Which,
-    /// Repetitions; the median is reported.
-    #[arg(long, default_value_t = 5)]
+    /// Repetitions (at least 1); the median is reported.
+    #[arg(long, default_value_t = 5, value_parser = at_least_one)]
     pub reps: usize,
     /// Small sizes only (for CI smoke runs).
     #[arg(long)]
@@ -58,6 +58,17 @@ pub struct BenchArgs {
     /// Write tables and charts here (`resolution`; default out/bench-resolution).
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+/// `--reps`: a median of no runs is no figure.
+fn at_least_one(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("--reps 0 runs nothing, and a median of no runs is no figure; give at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!(
+            "--reps {s}: {e}; give a whole number of repetitions, at least 1"
+        )),
+    }
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result, bail};
 use ndarray::{Array2, ArrayView2};
-use std::io::Cursor;
+use std::io::{Cursor, Read, Seek};
 use std::path::{Path, PathBuf};
 use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
@@ -19,6 +19,29 @@ pub struct Frame {
     pub bits: u8,
 }
 
+/// The largest decoded page lbdem accepts, in bytes: a 4096 × 4096 frame of 64-bit samples
+/// (128 MiB). The largest real detector frame the project reads is Su et al. 2020's 2048 × 2048
+/// 16-bit (8 MiB); the limit leaves room for 4k flat panels and float maps, and stops a header
+/// that claims more (a 300-byte file claiming 200000 × 200000 pixels asked for 80 GB) before
+/// anything is allocated.
+pub const MAX_FRAME_BYTES: usize = 4096 * 4096 * 8;
+
+/// The most pixels one file (all pages of a stack) may hold: 2^29 (4 GiB as f64, e.g. 128
+/// frames of 2048 × 2048). Pages can share their pixel data, so a small file could otherwise
+/// claim any number of full-size pages.
+pub const MAX_FILE_PIXELS: u64 = 1 << 29;
+
+/// Decoding limits of the `tiff` crate for lbdem's frames: the page limit above; tag values
+/// (strip offsets and counts, 8 bytes per strip) up to 4 MiB, which a 4096-row page with one row
+/// per strip needs 64 KiB of.
+fn limits() -> Limits {
+    let mut l = Limits::default();
+    l.decoding_buffer_size = MAX_FRAME_BYTES;
+    l.intermediate_buffer_size = MAX_FRAME_BYTES;
+    l.ifd_value_size = 4 << 20;
+    l
+}
+
 /// Every TIFF page of `path` (a stack yields several frames).
 pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
     let file = std::fs::File::open(path).with_context(|| {
@@ -27,16 +50,24 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
             path.display()
         )
     })?;
-    let mut dec = Decoder::new(std::io::BufReader::new(file))
-        .with_context(|| format!("{} is not a readable TIFF file", path.display()))?
-        .with_limits(Limits::unlimited());
+    read_pages_from(std::io::BufReader::new(file), &path.display().to_string())
+}
+
+/// Every TIFF page of the bytes `r` yields, labelled `name` in errors (the file's path). Memory
+/// is bounded by [`MAX_FRAME_BYTES`] per page and [`MAX_FILE_PIXELS`] per file whatever the
+/// header claims; bad input is an error, never a panic or an abort.
+pub fn read_pages_from<R: Read + Seek>(r: R, name: &str) -> Result<Vec<Frame>> {
+    let mut dec = Decoder::new(r)
+        .with_context(|| format!("{name} is not a readable TIFF file"))?
+        .with_limits(limits());
     let mut frames = Vec::new();
+    let mut pixels = 0u64;
     loop {
         let page = frames.len();
         let label = if page == 0 {
-            path.display().to_string()
+            name.to_string()
         } else {
-            format!("{}#{page}", path.display())
+            format!("{name}#{page}")
         };
         let (w, h) = dec
             .dimensions()
@@ -52,6 +83,24 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
                  ImageJ or tifffile) to one of these"
             ),
         };
+        let bytes = u64::from(w) * u64::from(h) * u64::from(bits / 8);
+        if bytes > MAX_FRAME_BYTES as u64 {
+            bail!(
+                "{label}: the header says {w} x {h} pixels of {bits} bits ({:.1} MiB), above lbdem's limit of \
+                 {} MiB per frame (4096 x 4096 x 64 bits; Su et al.'s detector gives 2048 x 2048 x 16 bits = \
+                 8 MiB); if the file is a real frame, crop or bin it, else it is damaged",
+                bytes as f64 / f64::from(1 << 20),
+                MAX_FRAME_BYTES >> 20
+            );
+        }
+        pixels += u64::from(w) * u64::from(h);
+        if pixels > MAX_FILE_PIXELS {
+            bail!(
+                "{label}: the stack holds more than {MAX_FILE_PIXELS} pixels in {} pages, above lbdem's limit per \
+                 file; split the stack into several files (a directory of frames is read in order)",
+                page + 1
+            );
+        }
         let img = dec
             .read_image()
             .with_context(|| format!("{label}: cannot decode the pixel data"))?;
@@ -78,7 +127,7 @@ pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
             break;
         }
         dec.next_image()
-            .with_context(|| format!("{}: cannot read page {}", path.display(), page + 1))?;
+            .with_context(|| format!("{name}: cannot read page {}", page + 1))?;
     }
     Ok(frames)
 }

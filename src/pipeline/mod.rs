@@ -32,6 +32,7 @@ fn writes_in_place(kind: &str) -> bool {
 /// created is removed again. Resumable stages work in [`PARTIAL`], which survives a killed
 /// process or an [`Interrupted`] stop; with `ctx.resume` the stage continues from it.
 pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
+    let kind = prepared.kind.clone();
     let inputs = cache::hash_inputs(&prepared.inputs)?;
     let key = cache::cache_key(&prepared.kind, &prepared.params_json, &inputs);
     let created = !ctx.out_dir.exists();
@@ -87,7 +88,24 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
     }
     let mut wctx = ctx.with_out_dir(staging.clone());
     wctx.key = key.clone();
-    let result = run_and_record(prepared, &wctx, key, inputs);
+    // A panic is a bug, but even then the stage leaves nothing behind: it becomes an error here
+    // and the working directory is removed below.
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        run_and_record(prepared, &wctx, key, inputs)
+    }))
+    .unwrap_or_else(|panic| {
+        let why = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(anyhow::anyhow!(
+            "stage '{}' (kind '{}') stopped on an internal error (a bug in lbdem; please report it with the \
+             input that caused it): {why}",
+            ctx.name,
+            kind
+        ))
+    });
     let interrupted = result
         .as_ref()
         .err()
@@ -240,7 +258,25 @@ pub fn run_pipeline(
         earlier.push((spec.name.clone(), dir));
         planned.push((ctx, prepared, spec));
     }
+    let created = !out.exists();
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    let result = run_planned(file, pipeline, &out, planned, opts);
+    if result.is_err() && created {
+        // Only succeeds when empty: a failed first stage leaves no empty output directory.
+        let _ = std::fs::remove_dir(&out);
+    }
+    result
+}
+
+/// The stages of a pipeline whose parameters are all parsed, in order, into `out`.
+fn run_planned(
+    file: &Path,
+    pipeline: &schema::Pipeline,
+    out: &Path,
+    planned: Vec<(StageContext, Prepared, &schema::StageSpec)>,
+    opts: RunOpts,
+) -> Result<Vec<StageRecord>> {
+    let out = out.to_path_buf();
     let mut prov = provenance::start(file, pipeline)?;
     let t_all = Instant::now();
     let say = |m: String| {

@@ -173,3 +173,31 @@ fn rerun_removes_the_earlier_runs_files_it_did_not_write_again() {
         serde_json::from_str(&std::fs::read_to_string(ctx.out_dir.join(MANIFEST)).unwrap()).unwrap();
     assert_eq!(rec.output.files, vec![PathBuf::from("a.txt")]);
 }
+
+/// A stage that panics (a bug) still leaves nothing behind: the panic becomes an error that
+/// says it is one, and the working directory and the output directory it created are removed.
+#[test]
+fn a_panicking_stage_becomes_an_error_and_leaves_nothing_behind() {
+    let (_d, input, ctx) = setup();
+    let p = Prepared::from_parts(
+        "test",
+        serde_json::json!({}),
+        vec![input],
+        |ctx: &StageContext| {
+            std::fs::create_dir_all(ctx.out_dir.join("snapshots"))?;
+            let v: Vec<u8> = Vec::new();
+            let _ = v[std::hint::black_box(3)];
+            Ok(StageOutput::default())
+        },
+    );
+    let e = format!("{:#}", execute(p, &ctx).unwrap_err());
+    assert!(
+        e.contains("internal error") && e.contains("index out of bounds"),
+        "{e}"
+    );
+    assert!(
+        !ctx.out_dir.exists(),
+        "left {:?}",
+        std::fs::read_dir(&ctx.out_dir).map(|d| d.count())
+    );
+}

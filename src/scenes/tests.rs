@@ -66,9 +66,12 @@ fn shipped(name: &str) -> String {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)).unwrap()
 }
 
+mod bad_input;
 mod coupled;
 mod dry;
 mod float;
 mod fluid;
+mod initial;
+mod initial_fluid;
 mod schema;
 mod shear_cell;

@@ -10,7 +10,7 @@
 //! overlay of the fitted circles on the image. User guide: docs/digitise.md.
 
 mod export;
-mod load;
+pub mod load;
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::{plot, table};
@@ -25,12 +25,6 @@ use std::path::{Path, PathBuf};
 
 fn d_smooth() -> f64 {
     lbdem_grains::Params::default().smooth_px
-}
-fn d_min_area() -> usize {
-    lbdem_grains::Params::default().min_grain_area_px
-}
-fn d_hole() -> usize {
-    lbdem_grains::Params::default().max_hole_area_px
 }
 fn d_h_rel() -> f64 {
     WatershedParams::default().h_rel
@@ -82,10 +76,13 @@ pub struct Params {
     pub smooth_px: f64,
     #[serde(default)]
     pub container: Container,
-    #[serde(default = "d_min_area")]
-    pub min_grain_area_px: usize,
-    #[serde(default = "d_hole")]
-    pub max_hole_area_px: usize,
+    /// Smaller solid pieces are specks; omitted: 5 % of the median grain area of a first pass
+    /// (`lbdem_grains::segment::sizes_from_first_pass`).
+    #[serde(default)]
+    pub min_grain_area_px: Option<usize>,
+    /// Enclosed liquid holes up to this area are filled; omitted: as `min_grain_area_px`.
+    #[serde(default)]
+    pub max_hole_area_px: Option<usize>,
     #[serde(default = "d_h_rel")]
     pub h_rel: f64,
     #[serde(default = "d_h_abs")]
@@ -101,14 +98,16 @@ pub struct Params {
 }
 
 impl Params {
+    /// The kernel's parameters; omitted sizes at the kernel's fixed defaults (the first pass).
     fn kernel(&self) -> lbdem_grains::Params {
+        let fixed = lbdem_grains::Params::default();
         lbdem_grains::Params {
             grains_are: self.grains_are,
             threshold: self.threshold,
             smooth_px: self.smooth_px,
             container: self.container.clone(),
-            min_grain_area_px: self.min_grain_area_px,
-            max_hole_area_px: self.max_hole_area_px,
+            min_grain_area_px: self.min_grain_area_px.unwrap_or(fixed.min_grain_area_px),
+            max_hole_area_px: self.max_hole_area_px.unwrap_or(fixed.max_hole_area_px),
             watershed: WatershedParams {
                 h_rel: self.h_rel,
                 h_abs: self.h_abs,
@@ -152,12 +151,29 @@ impl Stage for Digitise {
         }
         let path = p.image_path(ctx)?;
         let loaded = load::load(&path, p.channel)?;
-        let d = lbdem_grains::digitise(loaded.grey.view(), &p.kernel())
+        let mut kernel = p.kernel();
+        // Speck and hole sizes follow from the image unless given.
+        let first_pass = match (p.min_grain_area_px, p.max_hole_area_px) {
+            (Some(_), Some(_)) => None,
+            (min, hole) => {
+                let s = lbdem_grains::segment::sizes_from_first_pass(loaded.grey.view(), &kernel)
+                    .with_context(|| {
+                        format!(
+                            "digitise of {} (first pass, to size specks and holes)",
+                            path.display()
+                        )
+                    })?;
+                kernel.min_grain_area_px = min.unwrap_or(s.min_grain_area_px);
+                kernel.max_hole_area_px = hole.unwrap_or(s.max_hole_area_px);
+                Some(s)
+            }
+        };
+        let d = lbdem_grains::digitise(loaded.grey.view(), &kernel)
             .with_context(|| format!("digitise of {}", path.display()))?;
         for w in &d.warnings {
             eprintln!("digitise: warning: {} ({})", w, path.display());
         }
-        write_outputs(p, ctx, &path, &loaded, &d)
+        write_outputs(p, ctx, &path, &loaded, &d, &kernel, first_pass)
     }
 }
 
@@ -167,6 +183,8 @@ fn write_outputs(
     src: &Path,
     loaded: &load::Loaded,
     d: &Digitised,
+    kernel: &lbdem_grains::Params,
+    first_pass: Option<lbdem_grains::segment::FirstPassSizes>,
 ) -> Result<StageOutput> {
     let out = &ctx.out_dir;
     let px = p.pixel_size_m;
@@ -406,6 +424,9 @@ fn write_outputs(
         "axes": "particles.csv: x right, y up from the bottom-left corner of the image; grains.csv likewise",
         "container": d.mask.description,
         "threshold": d.threshold,
+        "min_grain_area_px": kernel.min_grain_area_px,
+        "max_hole_area_px": kernel.max_hole_area_px,
+        "sizes_first_pass": first_pass,
         "n_grains": d.grains.len(),
         "n_grains_cut_by_container": d.grains.iter().filter(|g| g.at_edge).count(),
         "n_circles": particles.len(),

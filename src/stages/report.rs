@@ -8,6 +8,7 @@ use crate::contract::{
     code_version,
 };
 use anyhow::{Context, Result, bail};
+use polars::prelude::{CsvReadOptions, DataType, SerReader};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -197,25 +198,38 @@ fn stage_view(rec: &StageRecord, dir: &Path, page_dir: &Path, rows: usize) -> Re
 
 fn table_view(dir: &Path, page_dir: &Path, file: &Path, caption: &str, rows: usize) -> Result<TableView> {
     let path = dir.join(file);
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("report: cannot read table {}", path.display()))?;
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap_or_default()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let all: Vec<&str> = lines.filter(|l| !l.is_empty()).collect();
-    let shown = all
+    // Every cell as its text (polars, no type inference), so the page shows what the file holds.
+    let df = CsvReadOptions::default()
+        .with_has_header(true)
+        .with_infer_schema_length(Some(0))
+        .try_into_reader_with_file_path(Some(path.clone()))
+        .and_then(|r| r.finish())
+        .map_err(|e| anyhow::anyhow!("report: cannot read table {}: {e}", path.display()))?;
+    let header = df.get_column_names().iter().map(|c| c.to_string()).collect();
+    let cols = df
+        .columns()
         .iter()
-        .take(rows)
-        .map(|l| l.split(',').map(format_cell).collect())
+        .map(|c| c.cast(&DataType::String))
+        .collect::<Result<Vec<_>, _>>()?;
+    let cols = cols
+        .iter()
+        .map(|c| {
+            c.str()
+                .map(|s| s.iter().map(|v| v.map(str::to_string)).collect::<Vec<_>>())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let shown = (0..df.height().min(rows))
+        .map(|r| {
+            cols.iter()
+                .map(|c| c[r].as_deref().map(format_cell).unwrap_or_default())
+                .collect()
+        })
         .collect();
+    let all = df.height();
     Ok(TableView {
         href: href(dir, page_dir, file),
         caption: caption.into(),
-        rows: all.len(),
+        rows: all,
         header,
         shown,
     })

@@ -233,7 +233,12 @@ mod tests {
                     block[k]["error"].as_f64().unwrap(),
                     block[k + 2]["error"].as_f64().unwrap(),
                 );
-                assert!((a - b).abs() < 0.01, "f64 {a} vs f32 {b}");
+                eprintln!(
+                    "settling study: error f64 {a:.6}, f32 {b:.6}, difference {:.2e}",
+                    (a - b).abs()
+                );
+                // Measured at most 4.7e-5 (test profile); the discretisation error is 7e-3..0.13.
+                assert!((a - b).abs() < 1e-4, "f64 {a} vs f32 {b}");
             }
         }
         // PSM (first block): refining from 6 to 8 cells per diameter lowers the error.

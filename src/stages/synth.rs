@@ -8,7 +8,7 @@
 //! assembly, a fully liquid pad (for `I_L^0` and Eq. 2 with `L_S.min = 0`).
 //!
 //! Attenuation defaults: NIST mass attenuation coefficients at 15 keV (Hubbell & Seltzer,
-//! via /work/shared/REFERENCES.md): Al 7.955 cm^2/g, Cu 74.05 cm^2/g, mixed by weight
+//! NISTIR 5632): Al 7.955 cm^2/g, Cu 74.05 cm^2/g, mixed by weight
 //! (`mu = rho sum w_i (mu/rho)_i`). Phase densities and compositions are explicit inputs;
 //! the defaults (solid alpha-Al 2700 kg/m^3 with no Cu, as REFERENCES.md; liquid
 //! Al-33wt%Cu at 3400 kg/m^3) are illustrative assumptions, not measured values.

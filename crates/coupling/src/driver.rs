@@ -324,6 +324,9 @@ impl<T: Real> Coupled<T> {
                 state.user_force.len()
             )));
         }
+        state.sys.check_state().map_err(|why| {
+            CouplingError::Unsupported(format!("coupled checkpoint: the grains are inconsistent: {why}"))
+        })?;
         self.fluid.restore(state.fluid)?;
         self.sys = state.sys;
         self.hydro = state.hydro;

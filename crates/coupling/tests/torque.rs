@@ -75,7 +75,9 @@ fn spinning_disk_torque_matches_couette() {
             if bb { "bounce-back" } else { "PSM" },
             100.0 * err
         );
-        // Staircase outer wall and the PSM/bounce-back inner boundary at a = 10 cells: a few %.
-        assert!(err.abs() < 0.08, "error {err}");
+        // Staircase outer wall and the PSM/bounce-back inner boundary at a = 10 cells: measured
+        // -2.64 % (PSM) and +1.61 % (bounce-back), test profile; tolerances twice those.
+        let tol = if bb { 0.033 } else { 0.053 };
+        assert!(err.abs() < tol, "error {err}");
     }
 }

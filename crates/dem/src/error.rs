@@ -18,10 +18,12 @@ pub enum DemError {
         m_min: f64,
         k_max: f64,
     },
-    #[error(
-        "body {body}: non-finite state at step {step} (position or velocity is NaN/inf); the run blew up, lower dt"
-    )]
+    #[error("body {body}: non-finite state at step {step} (position or velocity is NaN/inf); {}", blame(*step))]
     NonFinite { body: usize, step: u64 },
+    #[error(
+        "time step dt = {dt:e} s must be a positive, finite number of seconds; give dt below the critical step"
+    )]
+    BadTimeStep { dt: f64 },
     #[error("{name} = {value} is invalid: {why}")]
     BadParameter {
         name: &'static str,
@@ -33,4 +35,15 @@ pub enum DemError {
          — give a smaller domain (walls) or larger particles"
     )]
     TooManyCells { cells: usize },
+}
+
+/// What a non-finite state at `step` points to: in the first step the initial state (a NaN
+/// position, velocity or force, coincident circles), later an unstable run.
+fn blame(step: u64) -> &'static str {
+    if step == 0 {
+        "it is not finite from the start, so the initial state is to blame, not dt: check the particle \
+         positions and velocities, coincident circles, gravity and the wall velocities"
+    } else {
+        "the run blew up: lower dt (or stiffen less, damp more)"
+    }
 }

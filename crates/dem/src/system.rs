@@ -117,3 +117,119 @@ impl System {
         serde_json::from_slice(bytes)
     }
 }
+
+impl System {
+    /// Whether the state is one the stepper can advance: every per-body and per-circle array of
+    /// the same length, every index in range, the clump layout consistent, every number finite,
+    /// masses and radii positive. A state read back from a file (a damaged or foreign
+    /// checkpoint) is checked with this before it is used, so it is refused with the reason
+    /// instead of panicking inside a kernel.
+    pub fn check_state(&self) -> Result<(), String> {
+        let b = &self.bodies;
+        let (n, nc) = (b.pos.len(), b.circle_r.len());
+        let per_body = [
+            ("vel", b.vel.len()),
+            ("angle", b.angle.len()),
+            ("omega", b.omega.len()),
+            ("mass", b.mass.len()),
+            ("inertia", b.inertia.len()),
+            ("density", b.density.len()),
+            ("ext_force", b.ext_force.len()),
+            ("ext_torque", b.ext_torque.len()),
+            ("force", b.force.len()),
+            ("torque", b.torque.len()),
+            ("tag", b.tag.len()),
+        ];
+        if let Some((name, len)) = per_body.iter().find(|(_, l)| *l != n) {
+            return Err(format!("bodies.{name} has {len} entries for {n} bodies"));
+        }
+        if b.circle_offset.len() != nc || b.circle_body.len() != nc {
+            return Err(format!(
+                "{} circle offsets and {} circle bodies for {nc} circle radii",
+                b.circle_offset.len(),
+                b.circle_body.len()
+            ));
+        }
+        if b.circle_start.len() != n + 1
+            || b.circle_start.first() != Some(&0)
+            || b.circle_start.last() != Some(&nc)
+            || b.circle_start.windows(2).any(|w| w[0] >= w[1])
+        {
+            return Err(format!(
+                "circle_start must rise from 0 to {nc} over {} entries (each body one circle or more)",
+                n + 1
+            ));
+        }
+        for k in 0..n {
+            for c in b.circle_start[k]..b.circle_start[k + 1] {
+                if b.circle_body[c] as usize != k {
+                    return Err(format!(
+                        "circle {c} lies in body {k}'s range but names body {}",
+                        b.circle_body[c]
+                    ));
+                }
+            }
+        }
+        let finite2 = |v: &[Vec2]| v.iter().all(|p| p.x.is_finite() && p.y.is_finite());
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let positive = |v: &[f64]| v.iter().all(|x| *x > 0.0 && x.is_finite());
+        if !(finite2(&b.pos) && finite2(&b.vel) && finite(&b.angle) && finite(&b.omega))
+            || !(finite2(&b.circle_offset) && finite2(&b.ext_force) && finite(&b.ext_torque))
+        {
+            return Err("a position, velocity, angle or load is not finite".into());
+        }
+        if !(positive(&b.mass) && positive(&b.inertia) && positive(&b.circle_r)) {
+            return Err("a mass, inertia or circle radius is not positive and finite".into());
+        }
+        if !(self.time.is_finite() && self.time >= 0.0) {
+            return Err(format!(
+                "time = {} is not a finite, non-negative number",
+                self.time
+            ));
+        }
+        if let Some(&[i, j]) = self
+            .contacts
+            .pairs
+            .iter()
+            .find(|p| p[0] as usize >= nc || p[1] as usize >= nc)
+        {
+            return Err(format!(
+                "contact pair ({i}, {j}) names a circle beyond the {nc} circles"
+            ));
+        }
+        if self.contacts.hist.len() != self.contacts.pairs.len() {
+            return Err(format!(
+                "{} contact histories for {} pairs",
+                self.contacts.hist.len(),
+                self.contacts.pairs.len()
+            ));
+        }
+        if let Some(bond) = self
+            .bonds
+            .iter()
+            .find(|d| d.i as usize >= nc || d.j as usize >= nc)
+        {
+            return Err(format!(
+                "bond ({}, {}) names a circle beyond the {nc} circles",
+                bond.i, bond.j
+            ));
+        }
+        if let Some(m) = &self.membrane
+            && (m.reference.len() != m.bodies.len() || m.bodies.iter().any(|&k| k as usize >= n))
+        {
+            return Err("the membrane's bodies and reference positions do not match the bodies".into());
+        }
+        for (k, w) in self.walls.iter().enumerate() {
+            let ok = match w.shape {
+                crate::wall::WallShape::Plane { p, n } => finite2(&[p, n]) && n.norm() > 0.0,
+                crate::wall::WallShape::Segment { a, b } => finite2(&[a, b]),
+            };
+            if !ok || !finite2(&[w.vel]) {
+                return Err(format!(
+                    "wall {k} has a non-finite position or velocity, or a zero normal"
+                ));
+            }
+        }
+        Ok(())
+    }
+}

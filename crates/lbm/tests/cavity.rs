@@ -49,8 +49,9 @@ fn cavity(n: usize, re: f64, u_lid: f64, collision_of: impl Fn(f64) -> Collision
 #[test]
 fn re100_matches_ghia() {
     let err = cavity(64, 100.0, 0.1, |tau| Collision::Bgk { tau }, &GHIA_U_RE100);
-    // 64 nodes across, second-order scheme: within 2 % of the lid speed at every table point
-    assert!(err < 0.02, "{err}");
+    // 64 nodes across: measured 0.0061 of the lid speed at the worst table point (test
+    // profile, deterministic); the tolerance is twice that.
+    assert!(err < 0.012, "{err}");
 }
 
 /// `cargo test --release -p lbdem-lbm --test cavity -- --ignored`
@@ -64,5 +65,6 @@ fn re1000_matches_ghia() {
         |tau| Collision::Trt { tau, magic: 0.25 },
         &GHIA_U_RE1000,
     );
-    assert!(err < 0.02, "{err}");
+    // Measured 0.0061 (docs/lbm.md, release); the tolerance is twice that.
+    assert!(err < 0.012, "{err}");
 }

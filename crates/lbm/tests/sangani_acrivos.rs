@@ -66,7 +66,8 @@ fn check(l: usize, phis: &[usize], tol: f64) {
 
 #[test]
 fn drag_matches_table_quick() {
-    check(48, &[1, 2, 3], 0.05);
+    // Measured 2.39 %, 2.54 %, 2.49 % at Φ = 0.1, 0.2, 0.3 (test profile, deterministic).
+    check(48, &[1, 2, 3], 0.035);
 }
 
 /// Full table at L = 128: `cargo test --release -p lbdem-lbm --test sangani_acrivos -- --ignored`.

@@ -81,7 +81,10 @@ fn assert_ok_or_diagnosed(o: &Outcome, what: &str) {
         Outcome::Accurate(err) => assert!(*err < 0.05, "{what}: ran but nu error {err}"),
         Outcome::Warned(err) => {
             eprintln!("{what}: warned run, nu error {err:.3}");
-            assert!(err.is_finite())
+            // A warned run still answers: its ν error is bounded, if less tightly than an
+            // accurate one's. Measured up to 0.092 (BGK τ = 0.5005; the others 0.000-0.061, test
+            // profile, which rounds as release); the bound is about twice that.
+            assert!(*err < 0.2, "{what}: warned run with nu error {err}")
         }
         Outcome::Stopped(e) => {
             let LbmError::Unstable {

@@ -59,7 +59,8 @@ fn decay_rate_matches_viscosity_and_converges() {
     let e16 = nu_error(16, c, 0.01, false);
     let e32 = nu_error(32, c, 0.01, false);
     eprintln!("TG nu error: L=16 {e16:e}, L=32 {e32:e}");
-    assert!(e32 < 1e-2, "L=32: {e32}");
+    // Measured 1.14e-3 at L = 32 (and 4.6e-3 at L = 16; test profile, deterministic).
+    assert!(e32 < 2.3e-3, "L=32: {e32}");
     // second order in k: the error drops about fourfold when L doubles
     assert!(e16 / e32 > 3.0, "ratio {}", e16 / e32);
 }
@@ -77,5 +78,6 @@ fn trt_and_f32_storage_decay_alike() {
     );
     let e_f32 = nu_error(32, Collision::Bgk { tau: 0.8 }, 0.01, true);
     eprintln!("TG nu error: TRT {e_trt:e}, f32 {e_f32:e}");
-    assert!(e_trt < 1e-2 && e_f32 < 1e-2);
+    // Measured: TRT 9.3e-4, BGK with f32 storage 1.135e-3 (BGK f64: 1.136e-3).
+    assert!(e_trt < 1.9e-3 && e_f32 < 2.3e-3, "TRT {e_trt}, f32 {e_f32}");
 }

@@ -30,7 +30,11 @@ pub fn bodies(s: &Scene, base: &Path) -> Result<Bodies> {
             .with_context(|| format!("[particles] continue_from = {:?}", dir.display().to_string()));
     }
     Ok(match (&pc.csv, &pc.generate, &pc.assembly) {
-        (Some(path), None, None) => particles_csv::read_csv(&base.join(path), pc.density)?,
+        (Some(path), None, None) => particles_csv::read_csv_in(
+            &base.join(path),
+            pc.density,
+            Some((s.domain.lo2(), s.domain.hi2())),
+        )?,
         (None, None, Some(a)) => {
             let from = format!(
                 "[particles] assembly = {{ file = {:?} }}",

@@ -4,5 +4,6 @@
 
 pub mod assembly_file;
 pub mod dem;
+pub mod initial_fluid;
 pub mod lattice;
 pub mod particles_csv;

@@ -196,6 +196,16 @@ impl Model for Dry {
             cell: Option<Origin>,
         }
         let s: S = serde_json::from_value(state)?;
+        s.system
+            .check_state()
+            .map_err(|why| anyhow::anyhow!("the checkpoint's grains are inconsistent: {why}"))?;
+        if s.wall_start.len() != s.system.walls.len() {
+            anyhow::bail!(
+                "the checkpoint has {} wall start positions for {} walls",
+                s.wall_start.len(),
+                s.system.walls.len()
+            );
+        }
         // Where the walls started is part of the state: a [compress] preparation moved them
         // before the run, and a resumed run does not repeat it.
         self.sys = s.system;

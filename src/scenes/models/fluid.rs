@@ -34,6 +34,8 @@ pub fn build(s: &Scene, base: &Path) -> Result<Box<dyn Model>> {
 struct Geometry {
     spheres: Vec<(String, Motion, [f64; 3], f64)>,
     mask: Option<(String, Vec<bool>)>,
+    /// `[fluid] initial` (resolved) and `[fluid] u_max`.
+    initial: Option<(PathBuf, f64)>,
 }
 
 fn geometry(s: &Scene, su: &LatticeSetup, base: &Path) -> Result<Geometry> {
@@ -87,8 +89,8 @@ fn geometry(s: &Scene, su: &LatticeSetup, base: &Path) -> Result<Geometry> {
                 bail!("[mask] images are 2D; use [[obstacles]] spheres in 3D");
             }
             let path = base.join(&m.image);
-            let img = image::open(&path)
-                .with_context(|| format!("[mask] cannot read image {}", path.display()))?
+            let img = crate::io::image::open(&path)
+                .with_context(|| format!("[mask] image = {:?}", m.image))?
                 .to_luma8();
             if img.width() as usize != n[0] || img.height() as usize != n[1] {
                 bail!(
@@ -109,7 +111,15 @@ fn geometry(s: &Scene, su: &LatticeSetup, base: &Path) -> Result<Geometry> {
             Some((m.name.clone(), solid))
         }
     };
-    Ok(Geometry { spheres, mask })
+    let initial = s
+        .fluid
+        .as_ref()
+        .and_then(|f| f.initial.as_ref().map(|p| (base.join(p), f.u_max)));
+    Ok(Geometry {
+        spheres,
+        mask,
+        initial,
+    })
 }
 
 /// The kernel a scene runs on: in-place AA (half the memory traffic) unless a face is Zou-He.
@@ -152,6 +162,13 @@ impl<L: Lattice, T: Real> FluidModel<L, T> {
             bail!("the obstacles and mask cover every node; nothing to simulate");
         }
         let mut fluid = Fluid::<L, T>::new(dom, motions);
+        if let Some((path, u_max)) = &geo.initial {
+            let d = &fluid.domain;
+            let states =
+                crate::scenes::build::initial_fluid::read(path, su.n, su.dim, &d.kind, &su.units, *u_max)?;
+            let n = d.n;
+            fluid.init_equilibrium(|c| states[c[0] + n[0] * (c[1] + n[1] * c[2])]);
+        }
         let settings = Settings {
             collision: su.collision,
             force: su.force,

@@ -36,6 +36,13 @@ pub fn grains(s: &crate::scenes::schema::Scene, base: &std::path::Path) -> anyho
             sys.bodies.scale_sizes(f.sqrt());
             sys.contacts = Default::default();
         }
+        // The initial condition of the grains (checked finite with the scene's values).
+        if let Some([vx, vy]) = p.velocity {
+            sys.bodies.vel.fill(lbdem_dem::Vec2::new(vx, vy));
+        }
+        if let Some(w) = p.omega {
+            sys.bodies.omega.fill(w);
+        }
     }
     if let Some(d) = &s.dem {
         let f = d.mass_scale;

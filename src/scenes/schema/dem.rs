@@ -32,6 +32,13 @@ pub struct ParticlesSection {
     /// Sect. 2.4, Float: 0.9, "the area of each two-circle grain was reduced by 10 %").
     #[serde(default = "one")]
     pub area_factor: f64,
+    /// Initial velocity of every grain (m/s), `[vx, vy]`; default at rest (an impact test
+    /// launches its grains with it instead of with a moving wall).
+    #[serde(default)]
+    pub velocity: Option<[f64; 2]>,
+    /// Initial angular velocity of every grain (rad/s, counter-clockwise); default 0.
+    #[serde(default)]
+    pub omega: Option<f64>,
 }
 
 /// `[particles] assembly = { file = "...", grains = N, d = [d_min, d, d_max] }`: the assembly

@@ -19,6 +19,11 @@ pub struct FluidSection {
     pub dynamic_viscosity: Option<f64>,
     /// Largest liquid speed expected (m/s), for the Mach check (Su Eq. 16).
     pub u_max: f64,
+    /// The liquid's velocity and pressure at the start, from a fluid table (a run's
+    /// `fields/fluid_*.csv`/`.parquet`, or one written by hand with columns `i, j, k, ux, uy,
+    /// uz` in m/s and `pressure` in Pa): every liquid node once. Default: at rest.
+    #[serde(default)]
+    pub initial: Option<PathBuf>,
 }
 
 impl FluidSection {

@@ -8,6 +8,7 @@
 //! nearest valid name. Files of the earlier format (`[scene] kind = ...`, `[step]`, `[stop]`)
 //! get an error that says how to convert them. Format: docs/scenes.md.
 
+mod check;
 mod coupling;
 mod dem;
 mod fluid;
@@ -206,6 +207,8 @@ pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
     let mut sources = Vec::new();
     let (mut value, text) = read_table(path, &mut sources)?;
     merge(&mut value, overrides);
+    let own = std::fs::read_to_string(path).unwrap_or_default();
+    check::values(&value, path, &own, overrides)?;
     // Parse from text so that errors point at the line (overrides are re-serialised).
     let text = if overrides.is_empty() {
         text
@@ -215,6 +218,7 @@ pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
     let scene: Scene = toml::from_str(&text).map_err(|e| explain(e, path))?;
     let physics = scene
         .physics()
+        .and_then(|p| check::consistency(&scene).map(|()| p))
         .with_context(|| format!("scene file {}", path.display()))?;
     let stem = path
         .file_stem()

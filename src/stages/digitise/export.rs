@@ -3,9 +3,9 @@
 //! and `particles.json` beside it (the header: units, axes, pixel size, image size,
 //! source, container, counts, d_bar).
 
+use crate::report::table::{self, Col};
 use anyhow::Result;
 use serde::Serialize;
-use std::io::Write;
 use std::path::Path;
 
 /// One circle in SI, y up.
@@ -40,15 +40,20 @@ pub struct Header<'a> {
     pub solid_fraction_fitted: f64,
 }
 
+/// Write the circles through polars (`report::table::write_table`, atomic).
 pub fn write_particles(path: &Path, ps: &[Particle]) -> Result<()> {
-    lbdem_core::atomic::write_atomic_with(path, |w| {
-        writeln!(w, "grain_id,x,y,r")?;
-        for p in ps {
-            writeln!(w, "{},{:.9e},{:.9e},{:.9e}", p.grain_id, p.x, p.y, p.r)?;
-        }
-        Ok(())
-    })?;
-    Ok(())
+    let id: Vec<u64> = ps.iter().map(|p| p.grain_id as u64).collect();
+    let col = |f: fn(&Particle) -> f64| ps.iter().map(f).collect::<Vec<f64>>();
+    let (x, y, r) = (col(|p| p.x), col(|p| p.y), col(|p| p.r));
+    table::write_table(
+        path,
+        &[
+            ("grain_id", Col::U64(&id)),
+            ("x", Col::F64(&x)),
+            ("y", Col::F64(&y)),
+            ("r", Col::F64(&r)),
+        ],
+    )
 }
 
 pub fn write_header(path: &Path, h: &Header) -> Result<()> {

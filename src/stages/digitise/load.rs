@@ -3,7 +3,7 @@
 //! reader (`crate::io::tiff`), anything else (PNG, JPEG, 8/16-bit TIFF) through `image`, reduced to one grey
 //! channel in f64.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -29,22 +29,16 @@ pub struct Loaded {
 
 pub fn load(path: &Path, channel: Channel) -> Result<Loaded> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read image file {}", path.display()))?;
-    if bytes.is_empty() {
-        bail!(
-            "image file {} is empty (0 bytes): give a PNG, JPEG or TIFF image",
-            path.display()
-        );
-    }
+    load_bytes(&bytes, &path.display().to_string(), channel)
+}
+
+/// [`load`] from the file's bytes, `name` being the file in errors.
+pub fn load_bytes(bytes: &[u8], name: &str, channel: Channel) -> Result<Loaded> {
     let is_tiff = bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*");
-    if is_tiff && let Some(l) = load_float_tiff(path)? {
+    if is_tiff && let Some(l) = load_float_tiff(bytes, name) {
         return Ok(l);
     }
-    let img = image::load_from_memory(&bytes).with_context(|| {
-        format!(
-            "cannot decode image file {}: give a PNG, JPEG or TIFF (8/16-bit, or 32-bit float grey)",
-            path.display()
-        )
-    })?;
+    let img = crate::io::image::decode(bytes, name)?;
     let kind = format!("{:?}", img.color());
     let (w, h) = (img.width() as usize, img.height() as usize);
     let is16 = matches!(
@@ -76,15 +70,13 @@ fn pick(p: [f64; 3], channel: Channel) -> f64 {
 
 /// A one-sample float TIFF (through the one TIFF reader, `crate::io::tiff`), or `None` for
 /// any other TIFF (left to `image`, which also reads colour).
-fn load_float_tiff(path: &Path) -> Result<Option<Loaded>> {
-    let Ok(mut frames) = crate::io::tiff::read_pages(path) else {
-        return Ok(None);
-    };
+fn load_float_tiff(bytes: &[u8], name: &str) -> Option<Loaded> {
+    let mut frames = crate::io::tiff::read_pages_from(std::io::Cursor::new(bytes), name).ok()?;
     if frames.is_empty() || !matches!(frames[0].bits, 32 | 64) {
-        return Ok(None);
+        return None;
     }
-    Ok(Some(Loaded {
+    Some(Loaded {
         grey: frames.swap_remove(0).data,
         kind: "float".into(),
-    }))
+    })
 }

@@ -154,6 +154,7 @@ pub fn tangential(c: &ContactInput, h: &mut History, kt: f64, ct: f64, mu: f64, 
 /// model "C" of Ai, Chen, Rotter & Ooi, Powder Technol. 206 (2011) 269): M_r = −k_r θ_r,
 /// |M_r| ≤ μ_r r_eff F_n.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Rolling {
     /// Rolling stiffness k_r (N m / rad).
     pub k_r: f64,

@@ -248,7 +248,10 @@ impl Stepper {
         self.kick.resize(sys.bodies.len(), Kick::default());
         if self.checked_dt != dt || (self.n_circles, self.n_bodies) != shape {
             let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
-            if dt.is_nan() || dt <= 0.0 || dt > crit {
+            if !(dt > 0.0 && dt.is_finite()) {
+                return Err(DemError::BadTimeStep { dt });
+            }
+            if dt > crit {
                 return Err(DemError::TimeStepTooLarge {
                     dt,
                     critical: crit,

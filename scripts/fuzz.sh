@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The fuzz campaign: every reader of user input (tests/fuzz.rs) for N executions each
+# (default 1,000,000), in release, one target at a time, printing per target the executions,
+# wall time, accepted/refused counts and the peak memory of one execution.
+#   scripts/fuzz.sh [N] [TARGET...]      e.g. scripts/fuzz.sh 1000000 tiff scene_toml
+# LBDEM_FUZZ_SEED=K changes the mutation sequence (default 17, the one CI runs).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+n="${1:-1000000}"
+shift || true
+export LBDEM_FUZZ_EXECS="$n"
+cargo test --release --test fuzz -- --nocapture --test-threads 1 "$@" 2>&1 | grep -oE "fuzz [a-z_]+: .*|test result.*|panicked.*|FAILED.*"

@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# The slow validations: every #[ignore]d test that compares the code to a published figure or
+# an analytic solution, run one at a time in release, with a table of figure / reference /
+# tolerance / pass / wall time. The table and every test's log go to
+# reports/validation/<UTC date>-<git describe>/ (commit that directory: it is what makes the
+# docs' slow figures reproducible).
+#   scripts/validate-all.sh            # all of them (about an hour on 2 quiet cores)
+#   scripts/validate-all.sh cavity dkt # only the entries whose id contains one of the words
+#   scripts/validate-all.sh --list     # the table without running anything
+# Exit status: 0 when every test that ran passed.
+#
+# One line per validation below: crate | test file | test name | figure | reference | tolerance.
+# A new ignored validation gets a line here (tests/self_contained.rs checks that every ignored
+# test of the workspace is listed, or named as an exploration in EXPLORATIONS).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+VALIDATIONS='
+lbdem-lbm|cavity|re1000_matches_ghia|lid-driven cavity Re = 1000, N = 256: u on the vertical centreline|Ghia, Ghia & Shin 1982 Table I|max abs(u - u_Ghia) / U < 0.012 (measured 0.0061)
+lbdem-lbm|sangani_acrivos|drag_matches_table_full|drag of a square array of cylinders, L = 128, Φ = 0.05-0.5|Sangani & Acrivos 1982 Table 1|3 % (measured up to 2.6 %)
+lbdem-dem|packing|isotropic_compression_packing_fraction_full|jamming packing fraction of 4000 frictionless bidisperse disks|O'"'"'Hern et al. 2003: φ_J ≈ 0.84|± 0.02
+lbdem-coupling|sangani_psm|drag_matches_table_full|PSM drag of cylinder arrays at 32 and 64 cells, Φ = 0.1-0.3|Sangani & Acrivos 1982 Table 1|7 % at 32, 2.5 % at 64, error halves
+lbdem-coupling|settling_disk|settling_converges_with_resolution|terminal velocity of a disk between walls at 10, 16, 24 cells/d|Faxén 1946 wall-corrected Stokes drag|PSM 6 % and falling to < 1.5 %; bounce-back 1.5 %
+lbdem-coupling|low_resolution|fine_lattice_reference|permeability k/d̄² of the two-circle packing at 10, 20, 40 cells, Richardson-extrapolated|the test'"'"'s FINE_K (second order)|0.5 %
+lbdem-coupling|low_resolution|fine_disk_arrays_meet_the_table|drag of disk arrays at 40 cells/d, Φ = 0.1, 0.3, 0.5|Sangani & Acrivos 1982 Table 1|0.5 %, 3 %, 15 %
+lbdem-coupling|dkt|dkt_phases_at_finer_resolution|drafting, kissing, tumbling of two disks at 12 and 16 cells/d|Glowinski et al. 2001 set-up (phases only)|the three phases occur (test'"'"'s thresholds)
+lbdem-coupling|dkt_uhlmann|coarser_lattice_and_the_variants|DKT at 16 cells/d; without the interior-liquid correction, BGK, contact at the surfaces|Uhlmann 2005 Figs. 6a, 7a; Koblitz et al. 2017 Figs. 10a, 10c|0.1 d RMS to the kiss; tumble within the publications'"'"' times
+lbdem-coupling|dkt_uhlmann|finer_lattices_converge_into_the_published_envelope|DKT at 32 and 48 cells/d|Uhlmann 2005; Koblitz et al. 2017|as above, and inside the envelope at 48 (allowance: the publications'"'"' own difference)
+lbdem-coupling|dkt_uhlmann|finest_lattice_stays_in_the_published_envelope|DKT at 64 cells/d|Uhlmann 2005; Koblitz et al. 2017|inside the envelope (allowance: the publications'"'"' own difference)
+'
+# Ignored tests that are explorations (they print, they assert nothing): not validations.
+# shellcheck disable=SC2034
+EXPLORATIONS='lbdem-lbm|stability|explore_tau'
+
+list_only=0
+filters=()
+for a in "$@"; do
+  case "$a" in
+    --list) list_only=1 ;;
+    *) filters+=("$a") ;;
+  esac
+done
+
+selected() {
+  [ ${#filters[@]} -eq 0 ] && return 0
+  for f in "${filters[@]}"; do
+    case "$1" in *"$f"*) return 0 ;; esac
+  done
+  return 1
+}
+
+version=$(git describe --always --dirty 2>/dev/null || echo unknown)
+commit=$(git rev-parse HEAD 2>/dev/null || echo unknown)
+stamp=$(date -u +%Y-%m-%d)
+dir="reports/validation/$stamp-$version"
+table="| id | figure | reference | tolerance | pass | wall (s) |\n|---|---|---|---|---|---|\n"
+failed=0
+ran=0
+
+if [ $list_only -eq 0 ]; then
+  mkdir -p "$dir/logs"
+  cargo build --release --tests --workspace --quiet
+fi
+
+while IFS='|' read -r crate file name figure reference tolerance; do
+  [ -z "$crate" ] && continue
+  id="$crate/$file/$name"
+  selected "$id" || continue
+  if [ $list_only -eq 1 ]; then
+    table+="| $id | $figure | $reference | $tolerance | - | - |\n"
+    continue
+  fi
+  log="$dir/logs/$crate-$file-$name.log"
+  echo "== $id ($(date -u +%H:%M:%S), load $(cut -d' ' -f1 /proc/loadavg))" >&2
+  t0=$(date +%s.%N)
+  if cargo test --release --quiet -p "$crate" --test "$file" -- --ignored --exact "$name" --nocapture >"$log" 2>&1; then
+    pass=yes
+  else
+    pass=NO
+    failed=$((failed + 1))
+  fi
+  ran=$((ran + 1))
+  wall=$(echo "$(date +%s.%N) - $t0" | bc)
+  # A filter that names no test would pass vacuously: cargo reports "running 0 tests".
+  if ! grep -q "test result: .* 1 passed\|test result: FAILED" "$log"; then
+    pass="NOT RUN"
+    failed=$((failed + 1))
+  fi
+  table+="| $id | $figure | $reference | $tolerance | $pass | $(printf %.0f "$wall") |\n"
+done <<<"$VALIDATIONS"
+
+if [ $list_only -eq 1 ]; then
+  printf "%b" "$table"
+  exit 0
+fi
+
+{
+  echo "# Validation run $stamp"
+  echo
+  echo "- code version: $version ($commit, at the start of the run)"
+  echo "- command: scripts/validate-all.sh ${filters[*]:-}"
+  echo "- machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), load at the end $(cut -d' ' -f1 /proc/loadavg)"
+  echo "- $ran run, $failed failed or not run; each test's output in logs/"
+  echo
+  printf "%b" "$table"
+} >"$dir/README.md"
+cat "$dir/README.md"
+[ $failed -eq 0 ]

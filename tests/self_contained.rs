@@ -1,0 +1,95 @@
+//! Nothing in the repository points outside it (issue 17): a fresh clone's docs, comments,
+//! tests and scripts must work without the development machine's `shared/` directory.
+
+use std::path::{Path, PathBuf};
+
+fn files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            files(&p, out);
+        } else if p
+            .extension()
+            .is_some_and(|x| ["rs", "md", "toml", "sh", "py", "in"].contains(&x.to_str().unwrap_or("")))
+        {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn no_file_names_a_path_outside_the_repository() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut all = vec![root.join("README.md"), root.join("Cargo.toml")];
+    for d in [
+        "src",
+        "crates",
+        "tests",
+        "docs",
+        "scripts",
+        "scenes",
+        "pipelines",
+        "data/synth-alcu",
+    ] {
+        files(&root.join(d), &mut all);
+    }
+    assert!(all.len() > 100, "{}", all.len());
+    // Split so that this file does not match itself.
+    let needles = [
+        concat!("/wo", "rk/"),
+        concat!("../sha", "red"),
+        concat!("sha", "red/data"),
+    ];
+    let mut bad = Vec::new();
+    for f in &all {
+        let text = std::fs::read_to_string(f).unwrap_or_default();
+        for (n, line) in text.lines().enumerate() {
+            if needles.iter().any(|k| line.contains(k)) {
+                bad.push(format!("{}:{}: {line}", f.display(), n + 1));
+            }
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "paths outside the repository:\n{}",
+        bad.join("\n")
+    );
+}
+
+/// Every ignored test is a slow validation that `scripts/validate-all.sh` runs (or an
+/// exploration it names as such), so the docs' slow figures are reproducible from one command.
+#[test]
+fn every_ignored_test_is_listed_in_the_validation_script() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let script = std::fs::read_to_string(root.join("scripts/validate-all.sh")).unwrap();
+    let mut all = Vec::new();
+    for d in ["src", "crates", "tests"] {
+        files(&root.join(d), &mut all);
+    }
+    let mut ignored = Vec::new();
+    for f in all.iter().filter(|f| f.extension().is_some_and(|x| x == "rs")) {
+        let text = std::fs::read_to_string(f).unwrap_or_default();
+        let lines: Vec<&str> = text.lines().collect();
+        for (n, line) in lines.iter().enumerate() {
+            if !line.trim_start().starts_with(concat!("#[ig", "nore")) {
+                continue;
+            }
+            // The function the attribute belongs to: the next `fn` line.
+            let name = lines[n + 1..]
+                .iter()
+                .find_map(|l| l.trim_start().strip_prefix("fn "))
+                .and_then(|l| l.split('(').next())
+                .unwrap_or_else(|| panic!("{}:{}: no fn after the attribute", f.display(), n + 1));
+            ignored.push((f.display().to_string(), name.to_string()));
+        }
+    }
+    assert!(ignored.len() >= 10, "found only {ignored:?}");
+    let missing: Vec<_> = ignored
+        .iter()
+        .filter(|(_, name)| !script.contains(&format!("|{name}|")) && !script.contains(&format!("|{name}'")))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "ignored tests not in scripts/validate-all.sh (add a line: crate|file|name|figure|reference|tolerance): {missing:?}"
+    );
+}
