@@ -6,7 +6,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 work="${1:-$(mktemp -d)}"
 t0=$(date +%s)
-cargo build --features mpi --bin lbdem   # rebuilds the lbdem crate only (dependencies are shared)
+# Built as `cargo test` builds it (dev-dependencies' features unified), so after the README's
+# `cargo test` only the lbdem crate and the MPI crates compile; a plain `cargo build` would
+# rebuild polars with other features.
+cargo test --features mpi --no-run --test sweep_cli
 t1=$(date +%s)
 bin=target/debug/lbdem
 "$bin" sweep sweeps/su2020-ci.toml --out "$work/local"

@@ -669,6 +669,43 @@ fn restore_checkpoint(bytes: &[u8]) -> bool {
     (0..2).all(|_| m.step(false).is_ok())
 }
 
+fn assembly_header_seeds() -> Vec<Vec<u8>> {
+    vec![read("scenes/su2020/assemblies/reduced/assembly.json")]
+}
+
+/// The assembly header beside a fixed, valid assembly CSV (the reduced cell's).
+fn read_assembly_header(bytes: &[u8]) -> bool {
+    let csv = write_scratch(
+        "assembly.csv",
+        &read("scenes/su2020/assemblies/reduced/assembly.csv"),
+    );
+    write_scratch("assembly.json", bytes);
+    let expect = lbdem::scenes::build::assembly_file::Expect {
+        grains: 300,
+        d: None,
+        from: "fuzz",
+    };
+    lbdem::scenes::build::assembly_file::read_assembly(&csv, 0.52, &expect).is_ok()
+}
+
+fn sweep_seeds() -> Vec<Vec<u8>> {
+    [
+        "sweeps/su2020-ci.toml",
+        "sweeps/su2020-matrix.toml",
+        "sweeps/su2020-reduced-replicas.toml",
+    ]
+    .iter()
+    .map(|p| read(p))
+    .collect()
+}
+
+fn parse_sweep(bytes: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(bytes) else {
+        return false;
+    };
+    lbdem::sweep::schema::Sweep::parse(text, &repo("sweeps/fuzz.toml")).is_ok()
+}
+
 macro_rules! targets {
     ($($name:ident: $ci:expr, $seeds:expr, $bound:expr, $target:expr;)+) => {
         $(
@@ -693,4 +730,6 @@ targets! {
     snapshot_tables: 2_000, snapshot_seeds(), text_bound, read_snapshots;
     checkpoint_json: 2_000, checkpoint_seeds(), text_bound, restore_checkpoint;
     fluid_initial: 5_000, initial_fluid_seeds(), text_bound, read_initial_fluid;
+    assembly_header: 5_000, assembly_header_seeds(), text_bound, read_assembly_header;
+    sweep_toml: 20_000, sweep_seeds(), text_bound, parse_sweep;
 }
