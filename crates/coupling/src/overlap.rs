@@ -29,6 +29,11 @@ pub fn disk_rect_area(c: [f64; 2], r: f64, x0: f64, x1: f64, y0: f64, y1: f64) -
     if b <= a || y0 >= r || y1 <= -r {
         return 0.0;
     }
+    // The rectangle inside the disk (its farthest corner within r): no transcendental call.
+    let (fx, fy) = (x0.abs().max(x1.abs()), y0.abs().max(y1.abs()));
+    if fx * fx + fy * fy <= r * r {
+        return (x1 - x0) * (y1 - y0);
+    }
     // Breakpoints where +-h(x) crosses y0 or y1.
     let mut xs = [0.0f64; 6];
     let mut n = 0;
@@ -49,17 +54,22 @@ pub fn disk_rect_area(c: [f64; 2], r: f64, x0: f64, x1: f64, y0: f64, y1: f64) -
     n += 1;
     let xs = &mut xs[..n];
     xs.sort_by(f64::total_cmp);
+    // The antiderivative at each breakpoint once (two arcsines per piece otherwise).
+    let mut ih = [0.0f64; 6];
+    for (k, &x) in xs.iter().enumerate() {
+        ih[k] = int_h(x, r);
+    }
 
     let mut area = 0.0;
-    for w in xs.windows(2) {
-        let (p, q) = (w[0], w[1]);
+    for k in 0..n - 1 {
+        let (p, q) = (xs[k], xs[k + 1]);
         if q <= p {
             continue;
         }
         let m = 0.5 * (p + q);
         let hm = (r * r - m * m).max(0.0).sqrt();
         let span = q - p;
-        let ih = int_h(q, r) - int_h(p, r);
+        let ih = ih[k + 1] - ih[k];
         // Upper bound min(max(h, y0), y1) and lower bound min(max(-h, y0), y1) on (p, q).
         // Strict tests: a tie at the midpoint is a tangency (y0 = -r or y1 = r, where h
         // touches the edge at one point only), and there the unclipped +-h is right.
@@ -157,6 +167,13 @@ fn chord(r: f64, dist: f64) -> Option<f64> {
 /// closes to round-off even where a circle grazes an edge.
 pub fn rect_lens_area(a: ([f64; 2], f64), b: ([f64; 2], f64), x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
     if x1 <= x0 || y1 <= y0 || a.1 <= 0.0 || b.1 <= 0.0 {
+        return 0.0;
+    }
+    // The lens lies in both disks' bounding boxes: a rectangle outside their overlap (most
+    // cells of a two-circle grain cut by both circles) holds none of it.
+    let (lo_x, hi_x) = ((a.0[0] - a.1).max(b.0[0] - b.1), (a.0[0] + a.1).min(b.0[0] + b.1));
+    let (lo_y, hi_y) = ((a.0[1] - a.1).max(b.0[1] - b.1), (a.0[1] + a.1).min(b.0[1] + b.1));
+    if x0 >= hi_x || x1 <= lo_x || y0 >= hi_y || y1 <= lo_y {
         return 0.0;
     }
     // In the rectangle's frame (lower-left corner at the origin) to keep the sums small.
