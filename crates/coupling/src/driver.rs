@@ -20,8 +20,12 @@ use std::time::{Duration, Instant};
 pub struct Timing {
     pub lbm: Duration,
     pub dem: Duration,
-    /// Solid map, grain motions, load conversion.
+    /// Solid map, grain motions, solid zone, load conversion (the sum of the three below).
     pub coupling: Duration,
+    /// Of `coupling`: the grains' circles and motions on the lattice and the solid map.
+    pub map: Duration,
+    /// Of `coupling`: the solid zone of a confined liquid (membrane and push-plate).
+    pub zone: Duration,
 }
 
 /// Everything a [`Coupled`] run reads from one cycle to the next besides its configuration
@@ -40,6 +44,10 @@ pub struct CoupledState<T: Real> {
     /// Grain motions (lattice units) at the start of the previous LBM cycle.
     pub previous: Vec<GrainMotion>,
     pub fluid: HydroState<T>,
+    /// Where each grain was last mapped on the lattice (lattice units, scaled by r_hd), when the
+    /// solid map is kept between steps (`Hydro::set_remap_tolerance` above 0); else empty.
+    #[serde(default)]
+    pub mapped: Vec<GrainCircle>,
 }
 
 /// A coupled LBM-DEM run: the lattice, the grains and the scratch of both engines.
@@ -149,8 +157,10 @@ impl<T: Real> Coupled<T> {
             if self.dry[k] {
                 continue;
             }
+            // One sin_cos per grain, not per circle.
+            let (sin, cos) = b.angle[k].sin_cos();
             for c in b.circle_start[k]..b.circle_start[k + 1] {
-                let off = b.circle_offset[c].rotated(b.angle[k]);
+                let off = b.circle_offset[c].rotated_sc(sin, cos);
                 let cp = u.position_to_lattice([b.pos[k].x + off.x, b.pos[k].y + off.y]);
                 self.circles.push(GrainCircle {
                     body: k as u32,
@@ -224,6 +234,7 @@ impl<T: Real> Coupled<T> {
     pub fn step(&mut self) -> Result<(), CouplingError> {
         let t0 = Instant::now();
         self.map_grains()?;
+        let t_map = Instant::now();
         if let Some(c) = &mut self.confine {
             let [nx, ny] = self.fluid.size();
             let (zone, vel) = c.zone(&self.sys, &self.units, nx, ny);
@@ -256,6 +267,8 @@ impl<T: Real> Coupled<T> {
         }
         let t4 = Instant::now();
         self.timing.coupling += (t1 - t0) + (t3 - t2);
+        self.timing.map += t_map - t0;
+        self.timing.zone += t1 - t_map;
         self.timing.lbm += t2 - t1;
         self.timing.dem += t4 - t3;
         Ok(())
@@ -309,6 +322,7 @@ impl<T: Real> Coupled<T> {
             user_torque: self.user_torque.clone(),
             previous: self.previous.clone(),
             fluid: self.fluid.state(),
+            mapped: self.fluid.mapped_circles(),
         }
     }
 
@@ -328,6 +342,7 @@ impl<T: Real> Coupled<T> {
             CouplingError::Unsupported(format!("coupled checkpoint: the grains are inconsistent: {why}"))
         })?;
         self.fluid.restore(state.fluid)?;
+        self.fluid.restore_mapped(state.mapped, state.sys.domain.periodic);
         self.sys = state.sys;
         self.hydro = state.hydro;
         self.user_force = state.user_force;

@@ -5,7 +5,8 @@
 use crate::bounce::{BounceFluid, BounceState};
 use crate::error::CouplingError;
 use crate::psm::{GrainMotion, Load, PsmFluid, PsmState, ZoneMass};
-use crate::solid_fraction::{GrainCircle, SolidMap, solid_map};
+use crate::remap::SolidMapper;
+use crate::solid_fraction::{GrainCircle, SolidMap};
 use lbdem_lbm::Real;
 use lbdem_lbm::lattice::CS2;
 use serde::{Deserialize, Serialize};
@@ -43,7 +44,11 @@ pub enum HydroState<T: Real> {
 /// One per run: the size difference between the variants does not matter.
 #[allow(clippy::large_enum_variant)]
 pub enum Hydro<T: Real> {
-    Psm { fluid: PsmFluid<T>, map: SolidMap },
+    Psm {
+        fluid: PsmFluid<T>,
+        map: SolidMap,
+        mapper: SolidMapper,
+    },
     BounceBack(Box<BounceFluid<T>>),
 }
 
@@ -58,6 +63,53 @@ impl<T: Real> Hydro<T> {
                 covers: Vec::new(),
                 total: vec![0.0; nx * ny],
             },
+            mapper: SolidMapper::new(0.0),
+        }
+    }
+
+    /// Map a grain again only once it moved more than `cells` lattice cells ([`SolidMapper`];
+    /// 0, the default, maps every grain that moved). PSM only.
+    pub fn set_remap_tolerance(&mut self, cells: f64) -> Result<(), CouplingError> {
+        if !(cells.is_finite() && cells >= 0.0) {
+            return Err(CouplingError::Unsupported(format!(
+                "remap tolerance {cells} cells must be finite and at least 0"
+            )));
+        }
+        match self {
+            Hydro::Psm { mapper, .. } => {
+                *mapper = SolidMapper::new(cells);
+                Ok(())
+            }
+            Hydro::BounceBack(_) if cells == 0.0 => Ok(()),
+            Hydro::BounceBack(_) => Err(CouplingError::Unsupported(format!(
+                "[coupling] remap_tolerance = {cells}: bounce-back grains are mapped every step;                  use it with method = \"psm\" or set it to 0"
+            ))),
+        }
+    }
+
+    /// The circles each grain was last mapped at, where a resumed run needs them to map the same
+    /// grains at the same steps (a tolerance above 0); empty otherwise.
+    pub fn mapped_circles(&self) -> Vec<GrainCircle> {
+        match self {
+            Hydro::Psm { mapper, .. } if mapper.tolerance() > 0.0 => mapper.mapped().to_vec(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Continue the map from circles of [`Hydro::mapped_circles`] (nothing if empty).
+    pub fn restore_mapped(&mut self, circles: Vec<GrainCircle>, periodic: [bool; 2]) {
+        if let Hydro::Psm { fluid, mapper, .. } = self
+            && !circles.is_empty()
+        {
+            mapper.restore(circles, fluid.nx, fluid.ny, periodic);
+        }
+    }
+
+    /// Grains whose cover the last [`Hydro::map`] recomputed (PSM), all of them (bounce-back).
+    pub fn remapped(&self) -> Option<usize> {
+        match self {
+            Hydro::Psm { mapper, .. } => Some(mapper.remapped),
+            Hydro::BounceBack(_) => None,
         }
     }
     /// The state to checkpoint.
@@ -103,8 +155,8 @@ impl<T: Real> Hydro<T> {
         periodic: [bool; 2],
     ) -> Result<(), CouplingError> {
         match self {
-            Hydro::Psm { fluid, map } => {
-                *map = solid_map(circles, r_hd, fluid.nx, fluid.ny, periodic);
+            Hydro::Psm { map, mapper, .. } => {
+                mapper.map(circles, r_hd, periodic, map);
                 Ok(())
             }
             Hydro::BounceBack(b) => b.map(circles, motions, r_hd),
@@ -122,7 +174,7 @@ impl<T: Real> Hydro<T> {
     /// (`tests/dkt_uhlmann.rs`, 16 cells per diameter, τ = 0.51) the ε_s weight gives a drafting
     /// error of 0.04 d RMS, the B_s weight 0.14 d.
     pub fn interior_liquid(&self, motions: &[GrainMotion]) -> Option<Vec<InteriorLiquid>> {
-        let Hydro::Psm { fluid, map } = self else {
+        let Hydro::Psm { fluid, map, .. } = self else {
             return None;
         };
         let (nx, ny) = (fluid.nx, fluid.ny);
@@ -164,7 +216,7 @@ impl<T: Real> Hydro<T> {
     /// One LBM step; the load on each grain in lattice units.
     pub fn step(&mut self, motions: &[GrainMotion], loads: &mut Vec<Load>) -> Result<(), CouplingError> {
         match self {
-            Hydro::Psm { fluid, map } => fluid.step(map, motions, loads),
+            Hydro::Psm { fluid, map, .. } => fluid.step(map, motions, loads),
             Hydro::BounceBack(b) => b.step(loads, motions.len()),
         }
     }

@@ -3,7 +3,8 @@
 //! Eqs. 19-21) for comparison on the same cases.
 //!
 //! - geometry: the exact overlap of lattice cells with circles ([`overlap`]) and the per-cell
-//!   solid fraction of clumped grains with the hydrodynamic radius r_hd ([`solid_fraction`]);
+//!   solid fraction of clumped grains with the hydrodynamic radius r_hd ([`solid_fraction`]),
+//!   kept from step to step and recomputed for the grains that moved ([`remap`]);
 //! - the weighting B of Eq. 10 ([`weighting`]);
 //! - the PSM lattice: collision of Eqs. 9 and 11, force and moment of Eq. 14 ([`psm`]);
 //! - the liquid confined to a deforming sample, the moving "solid zone" ([`confine`]);
@@ -21,6 +22,7 @@ pub mod error;
 pub mod hydro;
 pub mod overlap;
 pub mod psm;
+pub mod remap;
 pub mod solid_fraction;
 pub mod weighting;
 

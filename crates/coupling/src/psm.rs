@@ -111,6 +111,9 @@ pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
     pub u: Vec<[f64; 3]>,
     /// Per cover of the last solid map: the load its grain received there.
     cover_load: Vec<ForceTorque>,
+    /// Scratch: covers of cell c are `covers[cover_start[c]..cover_start[c + 1]]` (kept between
+    /// steps: a fresh buffer of the lattice's size each step costs page faults).
+    cover_start: Vec<u32>,
     /// The 2D `step`'s grains and loads in the lattice-independent form (scratch).
     motions: Vec<Motion>,
     loads3: Vec<ForceTorque>,
@@ -249,6 +252,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             rho: vec![1.0; n],
             u: vec![[0.0; 3]; n],
             cover_load: Vec::new(),
+            cover_start: Vec::new(),
             motions: Vec::new(),
             loads3: Vec::new(),
             step: 0,
@@ -545,7 +549,9 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
         );
         let q = L::Q;
         // Covers of cell c are covers[start[c]..start[c + 1]] (the map is sorted by cell).
-        let mut start = vec![0u32; n + 1];
+        let mut start = std::mem::take(&mut self.cover_start);
+        start.clear();
+        start.resize(n + 1, 0);
         for cv in &map.covers {
             start[cv.cell as usize + 1] += 1;
         }
@@ -627,6 +633,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
         }
         std::mem::swap(&mut self.f, &mut self.other);
         self.step += 1;
+        self.cover_start = start;
 
         loads.clear();
         loads.resize(grains.len(), ForceTorque::default());

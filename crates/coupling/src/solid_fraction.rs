@@ -8,11 +8,11 @@
 //! kept apart (each grain gets its own force, Eq. 14) and scaled down together if they
 //! add up to more than one.
 
-use crate::overlap::{cell_fraction, cell_fraction_pair};
+use crate::overlap::{cell_fraction, rect_lens_area};
 use rayon::prelude::*;
 
 /// One circle of a grain, in lattice units (cell (i, j) spans [i, i+1] x [j, j+1]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GrainCircle {
     pub body: u32,
     pub centre: [f64; 2],
@@ -28,7 +28,8 @@ pub struct CellCover {
     pub fraction: f64,
 }
 
-/// Every covered cell's share per grain, sorted by cell then grain, and the total
+/// Every covered cell's share per grain, sorted by cell (within a cell in the order the grains
+/// were given, ascending body for the coupled loop), and the total
 /// solid fraction per cell (capped at one).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolidMap {
@@ -67,8 +68,14 @@ pub(crate) fn wrap(i: i64, n: usize, periodic: bool) -> Option<usize> {
     }
 }
 
-/// Cover of one grain (its circles already scaled by r_hd), unsorted.
-fn grain_cover(circles: &[GrainCircle], nx: usize, ny: usize, periodic: [bool; 2]) -> Vec<CellCover> {
+/// Cover of one grain (its circles already scaled by r_hd), unsorted, fractions not yet shared
+/// with the other grains.
+pub(crate) fn grain_cover(
+    circles: &[GrainCircle],
+    nx: usize,
+    ny: usize,
+    periodic: [bool; 2],
+) -> Vec<CellCover> {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for c in circles {
         for d in 0..2 {
@@ -95,13 +102,22 @@ fn grain_cover(circles: &[GrainCircle], nx: usize, ny: usize, periodic: [bool; 2
             } else if cutting <= 1 {
                 parts.iter().copied().fold(0.0, f64::max)
             } else if cutting == 2 {
-                let mut two = circles
-                    .iter()
-                    .zip(&parts)
-                    .filter(|(_, f)| **f > 0.0)
-                    .map(|(c, _)| (c.centre, c.radius));
+                // |C ∩ A| + |C ∩ B| − |C ∩ A ∩ B| with the two overlaps already at hand (the
+                // sum `cell_fraction_pair` computes).
+                let mut two = circles.iter().zip(&parts).filter(|(_, f)| **f > 0.0);
                 match (two.next(), two.next()) {
-                    (Some(a), Some(b)) => cell_fraction_pair(a, b, i, j),
+                    (Some((a, fa)), Some((b, fb))) => {
+                        let (x, y) = (i as f64, j as f64);
+                        let lens = rect_lens_area(
+                            (a.centre, a.radius),
+                            (b.centre, b.radius),
+                            x,
+                            x + 1.0,
+                            y,
+                            y + 1.0,
+                        );
+                        (fa + fb - lens).clamp(0.0, 1.0)
+                    }
                     _ => union_fraction(circles, i, j),
                 }
             } else {
@@ -135,27 +151,54 @@ pub fn solid_map(circles: &[GrainCircle], r_hd: f64, nx: usize, ny: usize, perio
         .par_iter()
         .map(|g| grain_cover(g, nx, ny, periodic))
         .collect();
-    let mut covers: Vec<CellCover> = per_grain.into_iter().flatten().collect();
-    // (cell, body) pairs are unique, so the unstable parallel sort is deterministic.
-    covers.par_sort_unstable_by_key(|c| (c.cell, c.body));
-    let mut total = vec![0.0; nx * ny];
-    for c in &covers {
-        total[c.cell as usize] += c.fraction;
+    let mut map = SolidMap {
+        nx,
+        ny,
+        covers: Vec::new(),
+        total: Vec::new(),
+    };
+    assemble(&per_grain, &mut map, &mut Vec::new());
+    map
+}
+
+/// Gather the grains' covers into `map` (whose `nx`, `ny` are set): a counting sort by cell,
+/// stable in grain order, so each cell lists its grains in the order of `per_grain` without a
+/// comparison sort; then the totals, with the fractions of a cell that overlapping grains (at
+/// contacts) cover more than once scaled down together.
+pub(crate) fn assemble(per_grain: &[Vec<CellCover>], map: &mut SolidMap, start: &mut Vec<u32>) {
+    let n = map.nx * map.ny;
+    start.clear();
+    start.resize(n + 1, 0);
+    for cv in per_grain.iter().flatten() {
+        start[cv.cell as usize + 1] += 1;
     }
-    // Overlapping grains (at contacts) must not cover a cell more than once.
-    for c in covers.iter_mut() {
-        let t = total[c.cell as usize];
+    for c in 0..n {
+        start[c + 1] += start[c];
+    }
+    let empty = CellCover {
+        cell: 0,
+        body: 0,
+        fraction: 0.0,
+    };
+    map.covers.clear();
+    map.covers.resize(start[n] as usize, empty);
+    for cv in per_grain.iter().flatten() {
+        let at = &mut start[cv.cell as usize];
+        map.covers[*at as usize] = *cv;
+        *at += 1;
+    }
+    map.total.clear();
+    map.total.resize(n, 0.0);
+    for c in &map.covers {
+        map.total[c.cell as usize] += c.fraction;
+    }
+    for c in map.covers.iter_mut() {
+        let t = map.total[c.cell as usize];
         if t > 1.0 {
             c.fraction /= t;
         }
     }
-    total.iter_mut().for_each(|t| *t = t.min(1.0));
-    SolidMap {
-        nx,
-        ny,
-        covers,
-        total,
-    }
+    map.total.iter_mut().for_each(|t| *t = t.min(1.0));
 }
 
 #[cfg(test)]

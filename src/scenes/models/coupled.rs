@@ -116,7 +116,7 @@ impl<T: Real> CoupledModel<T> {
             Collision::Trt { magic, .. } => Some(magic),
             Collision::Bgk { .. } => None,
         };
-        let hydro = match cs.method {
+        let mut hydro = match cs.method {
             Method::Psm => {
                 let fluid = PsmFluid::<T>::new(
                     &domain,
@@ -157,6 +157,9 @@ impl<T: Real> CoupledModel<T> {
                 dem.dt
             );
         }
+        hydro
+            .set_remap_tolerance(cs.remap_tolerance)
+            .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;
         let mut run = Coupled::new(hydro, sys, law, wall_law, dem.step_params(), units, cs.r_hd)
             .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;
         run.depth = cs.depth;

@@ -216,6 +216,11 @@ const RULES: &[Rule] = &[
         "hydrodynamic radius factor (0.8)",
     ),
     Rule("coupling.depth", Need::Positive, "sample depth (m)"),
+    Rule(
+        "coupling.remap_tolerance",
+        Need::NonNegative,
+        "grain displacement before it is mapped again (lattice cells, 0 = every move)",
+    ),
     Rule("run.time", Need::Positive, "simulated time (s)"),
     Rule("run.until_slower_than", Need::Positive, "speed (m/s)"),
     Rule("run.until_steady", Need::Positive, "relative change"),

@@ -26,6 +26,11 @@ pub struct CouplingSection {
     /// column: "LBM turned off, skipping steps 9-17"), keeping the scene's other sections.
     #[serde(default = "yes")]
     pub liquid: bool,
+    /// PSM only: a grain's solid fraction is computed again once it moved more than this many
+    /// lattice cells since it was last mapped (0: whenever it moved, Su Fig. 2 step 10). A speed
+    /// switch for quasi-static runs (issue 13 item 7; docs/su2020.md, "Speed").
+    #[serde(default)]
+    pub remap_tolerance: f64,
 }
 
 impl Default for CouplingSection {
@@ -37,6 +42,7 @@ impl Default for CouplingSection {
             dry_membrane: false,
             interior_liquid_correction: false,
             liquid: true,
+            remap_tolerance: 0.0,
         }
     }
 }
