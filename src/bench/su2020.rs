@@ -36,6 +36,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     dry_scene.coupling = None;
 
     let (mut t_coupled, mut t_dem, mut t_lbm) = (Vec::new(), Vec::new(), Vec::new());
+    // Inside the coupled step: solid map, solid zone, the rest of the coupling, PSM lattice
+    // step, DEM sub-steps (per LBM step).
+    let mut parts: Vec<[f64; 5]> = Vec::new();
     let mut info = None;
     for _ in 0..a.reps.max(1) {
         let mut m = coupled::build_f64(&l.scene, &l.base_dir).context("building the coupled case")?;
@@ -45,6 +48,15 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             m.step(false)?;
         }
         t_coupled.push(t0.elapsed().as_secs_f64() / steps as f64);
+        let tm = m.run.timing;
+        let per = |d: std::time::Duration| d.as_secs_f64() / steps as f64;
+        parts.push([
+            per(tm.map),
+            per(tm.zone),
+            per(tm.coupling - tm.map - tm.zone),
+            per(tm.lbm),
+            per(tm.dem),
+        ]);
         let cell = m.shear_cell().context("the scene has no [shear_cell]")?;
         info = Some((
             m.run.sys.bodies.len(),
@@ -110,6 +122,16 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         (c - dm - lb) * 1e3,
         (c - dm - lb) / c,
         a.reps.max(1)
+    );
+    let part = |k: usize| median(&parts.iter().map(|p| p[k]).collect::<Vec<_>>());
+    println!(
+        "  inside the coupled step (ms): solid map {:.3}, solid zone {:.3}, loads {:.3}, PSM lattice {:.3}, \
+         DEM {:.3}",
+        part(0) * 1e3,
+        part(1) * 1e3,
+        part(2) * 1e3,
+        part(3) * 1e3,
+        part(4) * 1e3
     );
     if let Some(j) = &a.json {
         std::fs::write(
