@@ -58,6 +58,25 @@ pub struct Pipeline {
     pub stages: Vec<StageSpec>,
 }
 
+/// Every string parameter that starts with `@` (a path in an earlier stage's output, see
+/// `StageContext::resolve`), with its key.
+fn at_references<'a>(v: &'a toml::Value, key: &str, out: &mut Vec<(String, &'a str)>) {
+    match v {
+        toml::Value::String(s) if s.starts_with('@') => out.push((key.to_string(), s)),
+        toml::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                at_references(x, &format!("{key}[{i}]"), out);
+            }
+        }
+        toml::Value::Table(t) => {
+            for (k, x) in t {
+                at_references(x, &format!("{key}.{k}"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
 impl Pipeline {
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)
@@ -78,7 +97,28 @@ impl Pipeline {
             bail!("pipeline file {} has no [[stage]] entries", path.display());
         }
         let mut seen = HashSet::new();
+        let mut earlier: Vec<&str> = Vec::new();
         for s in &f.stage {
+            let mut refs = Vec::new();
+            at_references(&s.params, "params", &mut refs);
+            for (key, value) in refs {
+                let name = value[1..].split('/').next().unwrap_or("");
+                if !earlier.contains(&name) {
+                    bail!(
+                        "pipeline file {}: stage '{}' {key} = \"{value}\" reads the output of a stage \
+                         '{name}', but no earlier stage has that name (earlier stages: {}); a stage \
+                         reads only what the stages above it wrote: fix the name or move the stage",
+                        path.display(),
+                        s.name,
+                        if earlier.is_empty() {
+                            "none".to_string()
+                        } else {
+                            earlier.join(", ")
+                        }
+                    );
+                }
+            }
+            earlier.push(&s.name);
             if !seen.insert(s.name.as_str()) {
                 bail!(
                     "pipeline file {}: two stages are named '{}'; stage names must be unique",

@@ -136,6 +136,29 @@ fn schema_rejects_duplicates_and_unknown_kinds() {
     assert_eq!(pl.out_dir(), PathBuf::from("pipelines/../reports/x"));
 }
 
+/// `@name/...` must name a stage above the one that reads it: a typo, a later stage or the
+/// stage itself is refused when the file is read, naming the key and the stages there are.
+#[test]
+fn an_at_reference_to_no_earlier_stage_is_refused_before_anything_runs() {
+    let p = std::path::Path::new("pipelines/x.toml");
+    let head = "[pipeline]\nname='x'\nout='o'\n[[stage]]\nname='synth'\nkind='report'\n";
+    let good = format!("{head}[[stage]]\nname='r'\nkind='report'\n[stage.params]\nx = ['@synth/frames']\n");
+    schema::Pipeline::parse(&good, p).unwrap();
+    for (bad, name) in [("@synht/frames", "synht"), ("@r", "r"), ("@later/x", "later")] {
+        let text = format!(
+            "{head}[[stage]]\nname='r'\nkind='report'\n[stage.params]\nsection = {{ frames = ['{bad}'] }}\n\
+             [[stage]]\nname='later'\nkind='report'\n"
+        );
+        let e = format!("{:#}", schema::Pipeline::parse(&text, p).unwrap_err());
+        assert!(
+            e.contains(&format!("params.section.frames[0] = \"{bad}\""))
+                && e.contains(&format!("a stage '{name}'"))
+                && e.contains("earlier stages: synth"),
+            "{e}"
+        );
+    }
+}
+
 /// A rerun that writes fewer files removes those of the earlier run (they would otherwise sit
 /// beside a manifest that does not list them), and leaves files it never owned alone.
 #[test]
