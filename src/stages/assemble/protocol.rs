@@ -382,20 +382,14 @@ pub fn run(p: &Params, ctx: &StageContext) -> Result<Done> {
         None => sys.membrane = None,
     }
     rec.membrane_grains = sys.membrane.as_ref().map_or(0, |m| m.bodies.len());
-    for v in sys.bodies.vel.iter_mut() {
-        *v = Vec2::ZERO;
-    }
-    for w in sys.bodies.omega.iter_mut() {
-        *w = 0.0;
-    }
-    sys.contacts = Default::default();
+    at_rest(&mut sys);
     let mut probe = sys.clone();
     let mut measure = Stepper::new();
-    let mut at_rest = run.step;
-    at_rest.dt = 1e-6 * run.step.dt;
-    at_rest.gravity = Vec2::ZERO;
+    let mut frozen = run.step;
+    frozen.dt = 1e-6 * run.step.dt;
+    frozen.gravity = Vec2::ZERO;
     measure
-        .step_law(&at_rest, &run.law, &run.wall_law, &mut probe)
+        .step_law(&frozen, &run.law, &run.wall_law, &mut probe)
         .context("the force evaluation that measures F_0")?;
     let (f0, n) = asm::mean_contact_force(&measure, &probe);
     rec.f_0 = f0;
@@ -451,13 +445,7 @@ fn prepare_relax(
     )
     .with_context(|| format!("[packing] target = {}", p.packing.target))?;
     rec.packing = Some(change);
-    for v in sys.bodies.vel.iter_mut() {
-        *v = Vec2::ZERO;
-    }
-    for w in sys.bodies.omega.iter_mut() {
-        *w = 0.0;
-    }
-    sys.contacts = Default::default();
+    at_rest(sys);
     sys.time = 0.0;
     sys.step = 0;
     Ok(())
@@ -528,4 +516,12 @@ impl Log {
             self.last = Instant::now();
         }
     }
+}
+
+/// Every grain stopped and the contact history cleared: the state the next phase of the
+/// protocol (F_0's force evaluation, relaxation after a %PK change) starts from.
+fn at_rest(sys: &mut System) {
+    sys.bodies.vel.iter_mut().for_each(|v| *v = Vec2::ZERO);
+    sys.bodies.omega.iter_mut().for_each(|w| *w = 0.0);
+    sys.contacts = Default::default();
 }
