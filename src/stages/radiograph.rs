@@ -446,6 +446,53 @@ struct FrameOut {
     profiles: Vec<ProfileOut>,
 }
 
+/// The float maps encoded and written on a second thread while the next frame is computed:
+/// writing them was half of the stage's time on 2048² frames (issue 18 item 5). At most two maps
+/// wait; dropping the writer (an error in the loop) waits for the maps already sent, so nothing
+/// is written into the stage's directory after the stage returned.
+struct MapWriter {
+    tx: Option<std::sync::mpsc::SyncSender<(PathBuf, Array2<f64>)>>,
+    handle: Option<std::thread::JoinHandle<Result<()>>>,
+}
+
+impl MapWriter {
+    fn new() -> Self {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<(PathBuf, Array2<f64>)>(2);
+        let handle = std::thread::spawn(move || {
+            for (path, map) in rx {
+                tio::write_f32(&path, map.view())?;
+            }
+            Ok(())
+        });
+        Self {
+            tx: Some(tx),
+            handle: Some(handle),
+        }
+    }
+
+    fn write(&mut self, path: PathBuf, map: Array2<f64>) -> Result<()> {
+        let sent = self.tx.as_ref().is_some_and(|tx| tx.send((path, map)).is_ok());
+        if sent { Ok(()) } else { self.finish() }
+    }
+
+    /// Wait for every map sent; the first write error, if any.
+    fn finish(&mut self) -> Result<()> {
+        drop(self.tx.take());
+        match self.handle.take() {
+            Some(h) => h
+                .join()
+                .map_err(|_| anyhow::anyhow!("the thread writing the float maps panicked"))?,
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for MapWriter {
+    fn drop(&mut self) {
+        let _ = self.finish();
+    }
+}
+
 fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageOutput> {
     let out = &ctx.out_dir;
     let mut files: Vec<PathBuf> = Vec::new();
@@ -463,6 +510,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
     let mut g_rev = Array2::zeros(shape);
     let mut frames_json = Vec::new();
     let mut outs = Vec::new();
+    let mut maps = MapWriter::new();
     for n in 0..nf {
         let gpix = pr.maps[n].field(pr.intensity[n].view());
         sat.build(gpix.view());
@@ -472,12 +520,12 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         let gs_tiles = sat.tiles(pr.rev_side, p.min_valid)?;
         let gname = format!("gs_rev_{n:03}");
         let gmap = if n == 0 { &g0_rev } else { &g_rev };
-        tio::write_f32(&out.join(format!("{gname}.tif")), gmap.view())?;
+        maps.write(out.join(format!("{gname}.tif")), gmap.clone())?;
         files.push(format!("{gname}.tif").into());
         if p.write_pixel_maps {
             for (name, f) in [("intensity", &pr.intensity[n]), ("gs_pixel", &gpix)] {
                 let fname = format!("{name}_{n:03}.tif");
-                tio::write_f32(&out.join(&fname), f.view())?;
+                maps.write(out.join(&fname), f.clone())?;
                 files.push(fname.into());
             }
         }
@@ -486,7 +534,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         let eps = (n > 0).then(|| bl::eps_vol_field(g0_rev.view(), g_rev.view(), p.eps_min_gs));
         if let Some(eps) = &eps {
             let ename = format!("eps_vol_{n:03}");
-            tio::write_f32(&out.join(format!("{ename}.tif")), eps.view())?;
+            maps.write(out.join(format!("{ename}.tif")), eps.clone())?;
             files.push(format!("{ename}.tif").into());
             eps_json = json!(finite_mean(eps));
             let g0t = outs
@@ -569,6 +617,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         });
         pb.inc(1);
     }
+    maps.finish()?;
     pb.finish_and_clear();
 
     // Tiled grid: one row per tile.
