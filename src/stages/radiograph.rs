@@ -780,8 +780,10 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         }
     }
 
-    for w in &pr.warnings {
-        eprintln!("radiograph: warning: {w}");
+    if !crate::contract::quiet() {
+        for w in &pr.warnings {
+            eprintln!("radiograph: warning: {w}");
+        }
     }
     let summary = json!({
         "frames": nf,
