@@ -107,6 +107,15 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         c * per_d,
         10.0 * c * per_d / 60.0
     );
+    // The scene's own stop may use another d̄ (the paper's Table 2, not the assembly's measured
+    // one): the time to it, at the same rate per LBM step.
+    if let Some(w) = &l.scene.run.until_wall_moved {
+        println!(
+            "  to the scene's stop, u_y = {:.3} mm: {:.1} min",
+            w.distance * 1e3,
+            c * w.distance / (speed * dt) / 60.0
+        );
+    }
     println!(
         "  DEM only {:9.3} ms per {ratio} DEM steps ({:.2} of coupled)",
         dm * 1e3,
