@@ -105,13 +105,6 @@ impl<T: Real> Hydro<T> {
         }
     }
 
-    /// Grains whose cover the last [`Hydro::map`] recomputed (PSM), all of them (bounce-back).
-    pub fn remapped(&self) -> Option<usize> {
-        match self {
-            Hydro::Psm { mapper, .. } => Some(mapper.remapped),
-            Hydro::BounceBack(_) => None,
-        }
-    }
     /// The state to checkpoint.
     pub fn state(&self) -> HydroState<T> {
         match self {

@@ -335,6 +335,29 @@ fn paper_steps() -> &'static Measures {
     })
 }
 
+/// `b` within the relative tolerances `eps` (ε_vol^DEM) and `force` (plate force) of `a`, and
+/// its displacement profile within `profile` × u_y of `a`'s.
+fn assert_within(a: &Measures, b: &Measures, eps: f64, force: f64, profile: f64) {
+    assert!(
+        (a.eps_vol - b.eps_vol).abs() < eps * a.eps_vol.abs(),
+        "ε_vol^DEM {} and {}",
+        a.eps_vol,
+        b.eps_vol
+    );
+    assert!(
+        (a.plate_force - b.plate_force).abs() < force * a.plate_force.abs(),
+        "plate force {} and {}",
+        a.plate_force,
+        b.plate_force
+    );
+    assert!(
+        profile_gap(a, b) < profile * a.displacement,
+        "profiles {:?} and {:?}",
+        a.profile,
+        b.profile
+    );
+}
+
 /// Largest difference between two displacement profiles.
 fn profile_gap(a: &Measures, b: &Measures) -> f64 {
     a.profile
@@ -361,24 +384,7 @@ fn mass_scaling_by_ten_leaves_the_strain_and_the_plate_force_unchanged() {
     // (0.7 % of u_y = 351 µm). Before that change: 0.5 %, 1.6 %, 2.2 %. The differences move
     // with last-bit changes of the set-up, so they are of the order of the chaotic spread of
     // one realisation; the tolerances are twice the larger of the two measurements.
-    assert!(
-        (a.eps_vol - b.eps_vol).abs() < 0.06 * a.eps_vol.abs(),
-        "ε_vol^DEM {} and {}",
-        a.eps_vol,
-        b.eps_vol
-    );
-    assert!(
-        (a.plate_force - b.plate_force).abs() < 0.16 * a.plate_force.abs(),
-        "plate force {} and {}",
-        a.plate_force,
-        b.plate_force
-    );
-    assert!(
-        profile_gap(a, &b) < 0.045 * a.displacement,
-        "profiles {:?} and {:?}",
-        a.profile,
-        b.profile
-    );
+    assert_within(a, &b, 0.06, 0.16, 0.045);
     // Quasi-static (I ≤ 1e-3, Su Sect. 3.4) once the grains carry stress: measured 3.7e-4
     // scaled, 1.2e-4 unscaled at the end.
     let i_end = *b.inertial.last().unwrap();
@@ -416,24 +422,7 @@ fn mass_scaling_by_a_hundred_at_simulation_ones_inertial_number() {
     let i_end = *b.inertial.last().unwrap();
     assert!(i_end < 1e-3, "inertial number {i_end}");
     // Bounds of the f = 10 test above (twice the spread last-bit changes cause).
-    assert!(
-        (a.eps_vol - b.eps_vol).abs() < 0.06 * a.eps_vol.abs(),
-        "ε_vol^DEM {} and {}",
-        a.eps_vol,
-        b.eps_vol
-    );
-    assert!(
-        (a.plate_force - b.plate_force).abs() < 0.16 * a.plate_force.abs(),
-        "plate force {} and {}",
-        a.plate_force,
-        b.plate_force
-    );
-    assert!(
-        profile_gap(&a, &b) < 0.045 * a.displacement,
-        "profiles {:?} and {:?}",
-        a.profile,
-        b.profile
-    );
+    assert_within(&a, &b, 0.06, 0.16, 0.045);
 }
 
 /// Keeping the solid map between LBM steps (`[coupling] remap_tolerance`, issue 13 item 7): a
@@ -452,22 +441,5 @@ fn keeping_the_solid_map_within_a_twentieth_of_a_cell_leaves_the_results_unchang
     // 0.010948 N (0.54 %), profiles at most 1.0 µm apart (0.29 % of u_y = 351 µm): smaller than
     // the spread last-bit changes of the set-up cause (the mass-scaling note above). Tolerances
     // are twice these; a change of the code that moves the chaos may need them measured again.
-    assert!(
-        (a.eps_vol - b.eps_vol).abs() < 0.011 * a.eps_vol.abs(),
-        "ε_vol^DEM {} and {}",
-        a.eps_vol,
-        b.eps_vol
-    );
-    assert!(
-        (a.plate_force - b.plate_force).abs() < 0.011 * a.plate_force.abs(),
-        "plate force {} and {}",
-        a.plate_force,
-        b.plate_force
-    );
-    assert!(
-        profile_gap(a, &b) < 0.006 * a.displacement,
-        "profiles {:?} and {:?}",
-        a.profile,
-        b.profile
-    );
+    assert_within(a, &b, 0.011, 0.011, 0.006);
 }
