@@ -87,11 +87,12 @@ fn replicas_of_the_reduced_cell_give_a_spread_of_the_strain_and_its_interval() {
     assert!(ok, "{err}");
     let res = out.join("results.csv");
     assert_eq!(numbers(&res, "seed"), [1.0, 2.0, 3.0]);
-    // Every assembly is scaled to the same packing fraction (reduced-assembly.toml: 0.85).
+    // Every assembly is scaled to the same packing fraction (pipelines/su2020-reduced-replica.toml:
+    // 0.84).
     assert!(
         numbers(&res, "packing_fraction")
             .iter()
-            .all(|p| (p - 0.85).abs() < 1e-9)
+            .all(|p| (p - 0.84).abs() < 1e-9)
     );
     let eps = numbers(&res, "eps_vol_half_d");
     let spread = eps.iter().copied().fold(f64::NEG_INFINITY, f64::max)
@@ -108,6 +109,170 @@ fn replicas_of_the_reduced_cell_give_a_spread_of_the_strain_and_its_interval() {
         "{m} ± {ci}"
     );
     assert!(out.join("figures/eps_vol_half_d_replicas.png").is_file());
+}
+
+/// The last particle snapshot in `dir`/snapshots.
+fn last_particles(dir: &Path) -> PathBuf {
+    let mut f: Vec<PathBuf> = std::fs::read_dir(dir.join("snapshots"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let n = p.file_name().unwrap().to_string_lossy();
+            n.starts_with("particles_") && n.ends_with(".csv")
+        })
+        .collect();
+    f.sort();
+    f.pop().unwrap()
+}
+
+/// Rise of the grains above the plate (3 < x < 5 mm at the start) in 1 mm bands from y = 1 mm,
+/// between the assembly's snapshot and the shear stage's last: the displacement profile.
+fn rise_profile(case: &Path) -> Vec<f64> {
+    let (before, after) = (
+        last_particles(&case.join("assembly")),
+        last_particles(&case.join("shear")),
+    );
+    let (x0, y0, y1) = (
+        numbers(&before, "body_x"),
+        numbers(&before, "body_y"),
+        numbers(&after, "body_y"),
+    );
+    let mut bands = [(0.0, 0usize); 6];
+    for c in 0..x0.len() {
+        if x0[c] > 3e-3 && x0[c] < 5e-3 {
+            let k = (((y0[c] - 1e-3) / 1e-3).max(0.0) as usize).min(5);
+            bands[k].0 += y1[c] - y0[c];
+            bands[k].1 += 1;
+        }
+    }
+    bands.iter().map(|(s, n)| s / (*n).max(1) as f64).collect()
+}
+
+/// What mass scaling by 100 changes on one assembly (f = 100 minus f = 1).
+struct Shift {
+    eps_vol: f64,
+    /// Relative to f = 1.
+    plate_force: f64,
+    /// Per band, as a fraction of f = 1's plate displacement.
+    profile: Vec<f64>,
+    /// f = 100's inertial number at the end.
+    inertial: f64,
+}
+
+/// sweeps/su2020-mass-scaling.toml with `replicas` assemblies: the shift of each.
+fn mass_scaling_pairs(replicas: usize) -> Vec<Shift> {
+    let t = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo("sweeps/su2020-mass-scaling.toml"))
+        .unwrap()
+        .replace("count = 16", &format!("count = {replicas}"))
+        .replace("\"../pipelines/", &format!("\"{}/", repo("pipelines").display()));
+    let f = t.path().join("mass.toml");
+    std::fs::write(&f, text).unwrap();
+    let out = t.path().join("out");
+    let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    // Every case finishes: at f = 1 two of six blew up while the replica pipeline left the
+    // assemblies compressed and the plate inside the bottom row.
+    assert!(ok, "{err}");
+    let res = out.join("results.csv");
+    let (scale, replica, case) = (
+        numbers(&res, "mass_scale"),
+        numbers(&res, "replica"),
+        column(&res, "case"),
+    );
+    let (eps, force, inertial) = (
+        numbers(&res, "eps_vol_end"),
+        numbers(&res, "plate_force_end"),
+        numbers(&res, "inertial_end"),
+    );
+    let row = |f: f64, r: usize| {
+        (0..scale.len())
+            .find(|&k| scale[k] == f && replica[k] == r as f64)
+            .unwrap_or_else(|| panic!("no case with mass_scale {f}, replica {r}"))
+    };
+    (0..replicas)
+        .map(|r| {
+            let (a, b) = (row(1.0, r), row(100.0, r));
+            let (pa, pb) = (
+                rise_profile(&out.join("cases").join(&case[a])),
+                rise_profile(&out.join("cases").join(&case[b])),
+            );
+            let u_y = *numbers(
+                &out.join("cases").join(&case[a]).join("shear/series.csv"),
+                "plate_displacement",
+            )
+            .last()
+            .unwrap();
+            Shift {
+                eps_vol: eps[b] - eps[a],
+                plate_force: (force[b] - force[a]) / force[a],
+                profile: pa.iter().zip(&pb).map(|(a, b)| (b - a) / u_y).collect(),
+                inertial: inertial[b],
+            }
+        })
+        .collect()
+}
+
+/// Mean and standard error.
+fn mean_se(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    let var = x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
+/// Per band, the largest |mean shift| + 2 standard errors over the assemblies.
+fn profile_bound(s: &[Shift]) -> f64 {
+    (0..s[0].profile.len())
+        .map(|k| {
+            let (m, se) = mean_se(&s.iter().map(|x| x.profile[k]).collect::<Vec<_>>());
+            m.abs() + 2.0 * se
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The fast version of the check below, on three assemblies: each pair within twice the largest
+/// shift the sixteen gave (ε_vol^DEM 0.00158, plate force 37 %, profile 8.4 % of u_y; measured
+/// on these three: +0.00115, +0.00054, -0.00019; +15 %, -20 %, -1 %; 0.6 %, 2.4 %, 3.0 %).
+#[test]
+fn mass_scaling_by_a_hundred_moves_no_assemblys_strain_beyond_twice_the_largest_shift_seen() {
+    let s = mass_scaling_pairs(3);
+    for x in &s {
+        let p = x.profile.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        eprintln!(
+            "eps_vol {:+.5}, plate force {:+.3}, profile {p:.4} of u_y",
+            x.eps_vol, x.plate_force
+        );
+        assert!(x.eps_vol.abs() < 0.0032, "eps_vol shift {}", x.eps_vol);
+        assert!(x.plate_force.abs() < 0.74, "plate force shift {}", x.plate_force);
+        assert!(p < 0.17, "profile shift {:?}", x.profile);
+    }
+}
+
+/// Issue 13 item 7: mass scaling by 100 (scenes/su2020/sim1-quick.toml) is harmless within the
+/// tolerance docs/su2020.md states: over sixteen assemblies, the mean shift plus two standard
+/// errors of ε_vol^DEM under 0.0018, of the plate force under 21 %, and of every band of the
+/// displacement profile under 4.6 % of u_y. Measured (2026-11-24): ε_vol^DEM
+/// -0.00048 ± 0.00021 (bound 0.0009), plate force -2.6 % ± 4.1 % (bound 10.7 %), profile bound
+/// 2.3 % of u_y (largest single band 8.4 %); the tolerances are twice the bounds. The spread of ε_vol^DEM between
+/// assemblies is 0.0037. 75 s on 2 cores.
+#[test]
+#[ignore = "75 s: cargo test --release --test sweep_cli -- --ignored mass_scaling_by_a_hundred_is"]
+fn mass_scaling_by_a_hundred_is_within_the_stated_tolerance_over_sixteen_assemblies() {
+    let s = mass_scaling_pairs(16);
+    let (me, se) = mean_se(&s.iter().map(|x| x.eps_vol).collect::<Vec<_>>());
+    let (mf, sf) = mean_se(&s.iter().map(|x| x.plate_force).collect::<Vec<_>>());
+    let pb = profile_bound(&s);
+    let pmax = s
+        .iter()
+        .flat_map(|x| x.profile.iter())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    eprintln!(
+        "eps_vol shift {me:.6} ± {se:.6}; plate force shift {mf:.4} ± {sf:.4}; profile bound {pb:.4}, largest single {pmax:.4} of u_y; f = 100 inertial number at the end: mean {:.2e}",
+        s.iter().map(|x| x.inertial).sum::<f64>() / 16.0
+    );
+    assert!(me.abs() + 2.0 * se < 0.0018, "eps_vol: {me} ± {se}");
+    assert!(mf.abs() + 2.0 * sf < 0.21, "plate force: {mf} ± {sf}");
+    assert!(pb < 0.046, "profile bound {pb}");
 }
 
 const SCENE: &str = r#"
