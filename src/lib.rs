@@ -8,6 +8,7 @@
 //! `contract` (the stage, output, manifest and provenance types) at the bottom for all of them,
 //! and `report` (plots, tables) and `io` (TIFF) as libraries the stages use.
 
+pub mod atlas;
 pub mod bench;
 pub mod cli;
 pub mod contract;

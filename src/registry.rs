@@ -54,6 +54,7 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::compare::Compare>(&["compare"], CliShape::ParamsFile),
     entry::<stages::mechanism_map::MechanismMap>(&["mechanism-map"], CliShape::ParamsFile),
     entry::<stages::matrix::Matrix>(&["matrix"], CliShape::ParamsFile),
+    entry::<stages::tradeoffs::Tradeoffs>(&["tradeoffs"], CliShape::ParamsFile),
 ];
 
 /// The stage kind named `kind`, or an error listing the known ones.

@@ -268,6 +268,31 @@ fn padded(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// A tick label with at most three significant digits: plain between 1e-3 and 1e4, else
+/// "2.5e-5" (plotters' default prints the float's full expansion, e.g. 0.00999999998).
+pub fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() {
+        return format!("{v}");
+    }
+    let s = if (1e-3..1e4).contains(&a) {
+        let digits = (2 - a.log10().floor() as i32).max(0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("{v:.2e}")
+    };
+    // Trailing zeros of the mantissa only ("2.50e-5" -> "2.5e-5", "1.00" -> "1").
+    let (mant, exp) = s
+        .split_once('e')
+        .map_or((s.as_str(), None), |(m, e)| (m, Some(e)));
+    let mant = if mant.contains('.') {
+        mant.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        mant
+    };
+    exp.map_or_else(|| mant.to_string(), |e| format!("{mant}e{e}"))
+}
+
 /// PNG x-y plot of one or more series (lines, or markers where `points`).
 pub fn xy_png(path: &Path, series: &[Series], opts: &XyPlot) -> Result<()> {
     for s in series {
@@ -308,6 +333,8 @@ pub fn xy_png(path: &Path, series: &[Series], opts: &XyPlot) -> Result<()> {
                     .configure_mesh()
                     .x_desc(opts.x_label)
                     .y_desc(opts.y_label)
+                    .x_label_formatter(&|v| tick_label(*v))
+                    .y_label_formatter(&|v| tick_label(*v))
                     .label_style((FONT, 13))
                     .light_line_style(RGBColor(235, 235, 235))
                     .draw()
@@ -463,6 +490,18 @@ mod tests {
     fn png_size(p: &Path) -> (u32, u32) {
         let img = image::open(p).unwrap();
         (img.width(), img.height())
+    }
+
+    #[test]
+    fn tick_labels_have_at_most_three_significant_digits() {
+        assert_eq!(tick_label(0.00999999998), "0.01");
+        assert_eq!(tick_label(0.002), "0.002");
+        assert_eq!(tick_label(1.0), "1");
+        assert_eq!(tick_label(250.0), "250");
+        assert_eq!(tick_label(-0.125), "-0.125");
+        assert_eq!(tick_label(2.5e-5), "2.5e-5");
+        assert_eq!(tick_label(1e-14), "1e-14");
+        assert_eq!(tick_label(0.0), "0");
     }
 
     #[test]

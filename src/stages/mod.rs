@@ -17,3 +17,4 @@ pub mod simulate;
 pub mod strain_fields;
 pub mod synth;
 pub mod synth_run;
+pub mod tradeoffs;

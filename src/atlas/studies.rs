@@ -1,0 +1,201 @@
+//! The atlas's studies. Each runs (or reads) the runs of one knob and returns its points; the
+//! caption of each (in the `tradeoffs` stage) states the case, the reference and the error
+//! measure.
+
+use super::Point;
+use super::channel::poiseuille;
+use crate::report::table::{f64_column, read_table};
+use anyhow::{Context, Result, bail};
+use lbdem_coupling::Method;
+use lbdem_coupling::cases::resolution::{Steady, disk_array, offsets, sangani_acrivos};
+use lbdem_coupling::cases::settling::{self, SettlingSpec};
+use lbdem_lbm::Collision;
+use polars::prelude::DataType;
+use std::path::Path;
+
+/// Lattice resolution: Stokes drag of a square array of disks at solid fraction `phi` against
+/// Sangani & Acrivos (1982) Table 1, PSM with BGK at τ = 1, at each number of cells per
+/// diameter; below 10 cells the answer depends on where the disk sits on the lattice, so it is
+/// the mean over 3 × 3 sub-cell offsets (2 × 2 up to 20 cells), and the wall time is per run.
+pub fn resolution(cells: &[f64], phi: f64) -> Result<Vec<Point>> {
+    let published = sangani_acrivos(phi).with_context(|| {
+        format!("solid fraction {phi} is not in Sangani & Acrivos's table (0.05, 0.1, 0.2 ... 0.5)")
+    })?;
+    let steady = Steady {
+        tol: 1e-7,
+        ..Steady::default()
+    };
+    cells
+        .iter()
+        .map(|&n| {
+            let k = if n <= 10.0 {
+                3
+            } else if n <= 20.0 {
+                2
+            } else {
+                1
+            };
+            let runs = offsets(k)
+                .into_iter()
+                .map(|o| disk_array(phi, n, o, 1.0, &steady))
+                .collect::<Result<Vec<_>, _>>()
+                .with_context(|| format!("disk array at {n} cells per diameter"))?;
+            let m = runs.len() as f64;
+            let drag = runs.iter().map(|r| r.drag).sum::<f64>() / m;
+            Ok(Point {
+                study: "resolution".into(),
+                setting: "PSM, BGK τ = 1".into(),
+                value: n,
+                error: (drag - published).abs() / published,
+                wall_seconds: runs.iter().map(|r| r.seconds).sum::<f64>() / m,
+            })
+        })
+        .collect()
+}
+
+/// Coupling method and storage precision: the settling disk (`lbdem_coupling::cases::settling`)
+/// against Faxén's wall-corrected Stokes drag, PSM and moving bounce-back, populations in f64 and
+/// f32, at each resolution. Returns the "method" points (f64, both methods) and the "precision"
+/// points (both precisions, both methods).
+pub fn coupling(resolutions: &[usize], duration: f64) -> Result<(Vec<Point>, Vec<Point>)> {
+    let (mut method, mut precision) = (Vec::new(), Vec::new());
+    for m in [Method::Psm, Method::BounceBack] {
+        let name = if m == Method::Psm { "PSM" } else { "bounce-back" };
+        for f32 in [false, true] {
+            for &n in resolutions {
+                let spec = SettlingSpec {
+                    cells_per_diameter: n,
+                    method: m,
+                    duration,
+                    ..Default::default()
+                };
+                let r = if f32 {
+                    settling::run::<f32>(&spec)
+                } else {
+                    settling::run::<f64>(&spec)
+                }
+                .with_context(|| format!("settling disk, {name}, {n} cells per diameter"))?;
+                let p = Point {
+                    study: "precision".into(),
+                    setting: format!("{name} {}", if f32 { "f32" } else { "f64" }),
+                    value: n as f64,
+                    error: r.error.abs(),
+                    wall_seconds: r.wall_seconds,
+                };
+                if !f32 {
+                    method.push(Point {
+                        study: "method".into(),
+                        setting: name.into(),
+                        ..p.clone()
+                    });
+                }
+                precision.push(p);
+            }
+        }
+    }
+    Ok((method, precision))
+}
+
+/// BGK against TRT: plane Poiseuille flow between halfway bounce-back walls ([`poiseuille`]),
+/// the largest deviation from the parabola over u_max, at each τ and channel height.
+pub fn collision(taus: &[f64], heights: &[usize]) -> Result<Vec<Point>> {
+    let mut out = Vec::new();
+    for &tau in taus {
+        let cs = [
+            (format!("BGK τ = {tau}"), Collision::Bgk { tau }),
+            (
+                format!("TRT Λ = 3/16, τ = {tau}"),
+                Collision::Trt {
+                    tau,
+                    magic: 3.0 / 16.0,
+                },
+            ),
+        ];
+        for (name, c) in cs {
+            for &h in heights {
+                let r = poiseuille(c, h).with_context(|| format!("channel of {h} rows, {name}"))?;
+                out.push(Point {
+                    study: "collision".into(),
+                    setting: name.clone(),
+                    value: h as f64,
+                    error: r.error,
+                    wall_seconds: r.seconds,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Mass scaling from a finished `lbdem sweep sweeps/su2020-mass-scaling.toml`: per mass scale
+/// f, the mean wall time of a case and the bound |mean paired shift| + 2 standard errors of
+/// ε_vol^DEM against f = 1 on the same assemblies (0 for f = 1 itself).
+pub fn mass_scaling(sweep: &Path) -> Result<Vec<Point>> {
+    let (res_path, cases_path) = (sweep.join("results.csv"), sweep.join("cases.csv"));
+    for p in [&res_path, &cases_path] {
+        if !p.is_file() {
+            bail!(
+                "mass_scaling = {}: {} is missing; run `lbdem sweep sweeps/su2020-mass-scaling.toml` first, or \
+                 leave mass_scaling out",
+                sweep.display(),
+                p.display()
+            );
+        }
+    }
+    let res = read_table(&res_path)?;
+    let cases = read_table(&cases_path)?;
+    let strings = |df: &polars::prelude::DataFrame, name: &str, path: &Path| -> Result<Vec<String>> {
+        let c = df
+            .column(name)
+            .map_err(|_| anyhow::anyhow!("table {} has no column '{name}'", path.display()))?
+            .cast(&DataType::String)?;
+        Ok(c.str()?.iter().map(|v| v.unwrap_or("").to_string()).collect())
+    };
+    let (case, scale, replica, eps) = (
+        strings(&res, "case", &res_path)?,
+        f64_column(&res, "mass_scale", &res_path)?,
+        f64_column(&res, "replica", &res_path)?,
+        f64_column(&res, "eps_vol_end", &res_path)?,
+    );
+    let (wall_case, wall) = (
+        strings(&cases, "case", &cases_path)?,
+        f64_column(&cases, "wall_s", &cases_path)?,
+    );
+    let wall_of = |c: &str| wall_case.iter().position(|w| w == c).map(|k| wall[k]);
+    let base: Vec<usize> = (0..case.len()).filter(|&k| scale[k] == 1.0).collect();
+    if base.is_empty() {
+        bail!(
+            "{}: no case with mass_scale 1, the reference of the study",
+            res_path.display()
+        );
+    }
+    let mut scales: Vec<f64> = scale.clone();
+    scales.sort_by(f64::total_cmp);
+    scales.dedup();
+    let mut out = Vec::new();
+    for f in scales {
+        let mut shifts = Vec::new();
+        let mut walls = Vec::new();
+        for k in (0..case.len()).filter(|&k| scale[k] == f) {
+            walls.extend(wall_of(&case[k]));
+            if let Some(&b) = base.iter().find(|&&b| replica[b] == replica[k]) {
+                shifts.push(eps[k] - eps[b]);
+            }
+        }
+        let n = shifts.len() as f64;
+        let mean = shifts.iter().sum::<f64>() / n;
+        let se = if n > 1.0 {
+            (shifts.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
+        } else {
+            f64::NAN
+        };
+        out.push(Point {
+            study: "mass-scaling".into(),
+            setting: format!("mass_scale {f}"),
+            value: f,
+            error: if f == 1.0 { 0.0 } else { mean.abs() + 2.0 * se },
+            wall_seconds: walls.iter().sum::<f64>() / walls.len().max(1) as f64,
+        });
+    }
+    Ok(out)
+}
