@@ -33,12 +33,33 @@ pub struct Params {
     /// Channel heights (fluid rows) of the BGK-against-TRT study.
     #[serde(default = "heights")]
     pub heights: Vec<usize>,
-    /// A finished `lbdem sweep sweeps/su2020-mass-scaling.toml` directory (left out if absent).
+    /// Knobs read from finished sweeps with replicas (mass scaling, the DEM step).
     #[serde(default)]
-    pub mass_scaling: Option<PathBuf>,
+    pub sweeps: Vec<SweepStudy>,
     /// rayon threads for every run, 0 = all.
     #[serde(default)]
     pub threads: usize,
+}
+
+/// A study read from a finished sweep: the paired shift of `result` against the case at
+/// `reference` of `axis`, per value of the axis ([`studies::paired`]).
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepStudy {
+    /// Its name in the table and its chart's file name (tradeoff_<study>.png).
+    pub study: String,
+    /// One sentence for the caption: the case and the knob.
+    pub what: String,
+    /// The sweep's out directory.
+    pub dir: PathBuf,
+    pub axis: String,
+    pub reference: f64,
+    #[serde(default = "eps_vol_end")]
+    pub result: String,
+}
+
+fn eps_vol_end() -> String {
+    "eps_vol_end".into()
 }
 
 fn resolution() -> Vec<f64> {
@@ -62,10 +83,10 @@ fn heights() -> Vec<usize> {
 
 /// A study's chart: file, title, error label, caption, log axes.
 struct Chart {
-    study: &'static str,
-    file: &'static str,
-    title: &'static str,
-    error: &'static str,
+    study: String,
+    file: String,
+    title: String,
+    error: String,
     caption: String,
     log: bool,
 }
@@ -78,9 +99,9 @@ impl Stage for Tradeoffs {
     type Params = Params;
 
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
-        p.mass_scaling
+        p.sweeps
             .iter()
-            .map(|d| ctx.resolve(d))
+            .map(|s| ctx.resolve(&s.dir))
             .flat_map(|d| [d.join("results.csv"), d.join("cases.csv")])
             .filter(|f| f.is_file())
             .collect()
@@ -93,18 +114,20 @@ impl Stage for Tradeoffs {
             !p.resolution.is_empty(),
             !p.settling.is_empty(),
             !p.taus.is_empty(),
-            p.mass_scaling.is_some(),
         ];
-        let bar = ctx.progress_bar(work.iter().filter(|w| **w).count() as u64, "studies");
+        let bar = ctx.progress_bar(
+            (work.iter().filter(|w| **w).count() + p.sweeps.len()) as u64,
+            "studies",
+        );
         let mut points: Vec<Point> = Vec::new();
         let mut charts: Vec<Chart> = Vec::new();
         if work[0] {
             points.extend(pool.install(|| studies::resolution(&p.resolution, p.phi))?);
             charts.push(Chart {
-                study: "resolution",
-                file: "tradeoff_resolution.png",
-                title: "lattice resolution: disk-array drag",
-                error: "|F - F_SA| / F_SA",
+                study: "resolution".into(),
+                file: "tradeoff_resolution.png".into(),
+                title: "lattice resolution: disk-array drag".into(),
+                error: "|F - F_SA| / F_SA".into(),
                 caption: format!(
                     "Lattice resolution. Stokes drag F/(μU) of a square array of disks at solid fraction {} (PSM, BGK τ = 1) \
                      against Sangani & Acrivos (1982) Table 1, at {:?} cells per diameter (Su et al. 2020 run at 2.4); \
@@ -126,18 +149,18 @@ impl Stage for Tradeoffs {
                 p.settling
             );
             charts.push(Chart {
-                study: "method",
-                file: "tradeoff_method.png",
-                title: "coupling: PSM against moving bounce-back",
-                error: "|U - U_Faxén| / U_Faxén",
+                study: "method".into(),
+                file: "tradeoff_method.png".into(),
+                title: "coupling: PSM against moving bounce-back".into(),
+                error: "|U - U_Faxén| / U_Faxén".into(),
                 caption: format!("Coupling method, f64 populations: {case}"),
                 log: true,
             });
             charts.push(Chart {
-                study: "precision",
-                file: "tradeoff_precision.png",
-                title: "storage: f64 against f32 populations",
-                error: "|U - U_Faxén| / U_Faxén",
+                study: "precision".into(),
+                file: "tradeoff_precision.png".into(),
+                title: "storage: f64 against f32 populations".into(),
+                error: "|U - U_Faxén| / U_Faxén".into(),
                 caption: format!("Population storage, f64 and f32, both coupling methods: {case}"),
                 log: true,
             });
@@ -146,10 +169,10 @@ impl Stage for Tradeoffs {
         if work[2] {
             points.extend(pool.install(|| studies::collision(&p.taus, &p.heights))?);
             charts.push(Chart {
-                study: "collision",
-                file: "tradeoff_collision.png",
-                title: "collision: BGK against TRT",
-                error: "max |u - u_exact| / u_max",
+                study: "collision".into(),
+                file: "tradeoff_collision.png".into(),
+                title: "collision: BGK against TRT".into(),
+                error: "max |u - u_exact| / u_max".into(),
                 caption: format!(
                     "Collision operator. Plane Poiseuille flow between halfway bounce-back walls, {:?} fluid rows, \
                      τ = {:?}: the largest deviation from the parabola over the peak velocity. TRT at Λ = 3/16 is exact at \
@@ -161,19 +184,29 @@ impl Stage for Tradeoffs {
             });
             bar.inc(1);
         }
-        if let Some(dir) = &p.mass_scaling {
-            points.extend(studies::mass_scaling(&ctx.resolve(dir))?);
+        for s in &p.sweeps {
+            points.extend(studies::paired(
+                &s.study,
+                &ctx.resolve(&s.dir),
+                &s.axis,
+                s.reference,
+                &s.result,
+            )?);
             charts.push(Chart {
-                study: "mass-scaling",
-                file: "tradeoff_mass_scaling.png",
-                title: "mass scaling of the reduced shear cell",
-                error: "|mean Δε_vol| + 2 SE",
+                study: s.study.clone(),
+                file: format!("tradeoff_{}.png", s.study),
+                title: format!("{}: paired shift of {} against {} = {}", s.study, s.result, s.axis, s.reference),
+                error: format!("|mean Δ{}| + 2 SE", s.result),
                 caption: format!(
-                    "Mass scaling (Simulation I's speed switch) on the reduced shear cell, from the sweep in {}: per mass \
-                     scale, the mean wall time of a case (assembly and shear) and the bound on the shift of ε_vol^DEM \
-                     against mass_scale 1 on the same assemblies (mean paired shift plus two standard errors; 0 for \
-                     mass_scale 1 itself). docs/su2020.md, \"Speed\", states the tolerance.",
-                    dir.display()
+                    "{} From the sweep in {}: per value of {}, the mean wall time of a case and the bound on the shift \
+                     of {} against {} = {} on the same replicas (mean paired shift plus two standard errors; 0 for the \
+                     reference itself).",
+                    s.what,
+                    s.dir.display(),
+                    s.axis,
+                    s.result,
+                    s.axis,
+                    s.reference
                 ),
                 log: false,
             });
@@ -193,12 +226,12 @@ impl Stage for Tradeoffs {
             let sel: Vec<Point> = idx.iter().map(|&k| points[k].clone()).collect();
             let on: Vec<bool> = idx.iter().map(|&k| front[k]).collect();
             pareto_png(
-                &ctx.out_dir.join(c.file),
+                &ctx.out_dir.join(&c.file),
                 &sel,
                 &on,
                 &Axes {
-                    title: c.title,
-                    error_label: c.error,
+                    title: &c.title,
+                    error_label: &c.error,
                     log: c.log,
                 },
             )?;
@@ -224,7 +257,7 @@ impl Stage for Tradeoffs {
             .zip(&front)
             .map(|(q, f)| serde_json::json!({ "point": q, "non_dominated": f }))
             .collect();
-        let mut files: Vec<PathBuf> = charts.iter().map(|c| PathBuf::from(c.file)).collect();
+        let mut files: Vec<PathBuf> = charts.iter().map(|c| PathBuf::from(&c.file)).collect();
         files.push("tradeoffs.csv".into());
         Ok(StageOutput {
             summary: serde_json::json!({ "points": summary }),
@@ -312,7 +345,7 @@ mod tests {
             duration: 0.6,
             taus: vec![0.8, 1.5],
             heights: vec![8, 16],
-            mass_scaling: None,
+            sweeps: Vec::new(),
             threads: 0,
         };
         let out = Tradeoffs::run(&p, &ctx).unwrap();
@@ -348,14 +381,19 @@ mod tests {
                 );
             }
         }
-        // Collision: BGK slips by (16Λ - 3)/(3h²) of u_max (Λ = (τ - ½)²), TRT at Λ = 3/16 not
+        // Collision: BGK (Λ = (τ - ½)²) and TRT at Λ = 1/4 slip by (16Λ - 3)/(3h²) of u_max, TRT at Λ = 3/16 not
         // at all (measured at most 4.3e-11, the steady-state tolerance's trace).
         for p in pts(&out, "collision") {
             let (h, e) = (num(p, "value"), num(p, "error"));
             let setting = p["point"]["setting"].as_str().unwrap();
-            if let Some(tau) = setting.strip_prefix("BGK τ = ") {
+            let lambda = if let Some(tau) = setting.strip_prefix("BGK τ = ") {
                 let tau: f64 = tau.parse().unwrap();
-                let want = (16.0 * (tau - 0.5).powi(2) - 3.0).abs() / (3.0 * h * h);
+                Some((tau - 0.5).powi(2))
+            } else {
+                setting.starts_with("TRT Λ = 1/4").then_some(0.25)
+            };
+            if let Some(lambda) = lambda {
+                let want = (16.0 * lambda - 3.0).abs() / (3.0 * h * h);
                 assert!(
                     (e - want).abs() < 1e-6 * want.max(1e-3),
                     "{setting}, h {h}: {e} vs {want}"
@@ -386,7 +424,10 @@ mod tests {
         let mut p: Params = toml::from_str("taus = [0.5]").unwrap();
         let e = Tradeoffs::run(&p, &ctx).unwrap_err().to_string();
         assert!(e.contains("taus") && e.contains("above 1/2"), "{e}");
-        p = toml::from_str("resolution = []\nsettling = []\ntaus = []\nmass_scaling = \"nowhere\"").unwrap();
+        p = toml::from_str(
+            "resolution = []\nsettling = []\ntaus = []\n[[sweeps]]\nstudy = \"mass-scaling\"\nwhat = \"x\"\ndir = \"nowhere\"\naxis = \"mass_scale\"\nreference = 1.0",
+        )
+        .unwrap();
         let e = Tradeoffs::run(&p, &ctx).unwrap_err().to_string();
         assert!(e.contains("nowhere") && e.contains("lbdem sweep"), "{e}");
     }
