@@ -242,10 +242,16 @@ mod tests {
         let p = paired("s", d.path(), "f", 1.0, "eps_vol_end").unwrap();
         assert_eq!(p.len(), 3);
         assert_eq!((p[0].error, p[0].wall_seconds), (0.0, 4.0));
-        assert!((p[1].error - (2.0 + 2.0 / 3f64.sqrt())).abs() < 1e-12, "{:?}", p[1]);
+        assert!(
+            (p[1].error - (2.0 + 2.0 / 3f64.sqrt())).abs() < 1e-12,
+            "{:?}",
+            p[1]
+        );
         assert_eq!(p[2].setting, "f 3 (2 of 3 failed)");
         assert!(p[2].error.is_infinite());
-        let e = paired("s", d.path(), "f", 9.0, "eps_vol_end").unwrap_err().to_string();
+        let e = paired("s", d.path(), "f", 9.0, "eps_vol_end")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("f = 9"), "{e}");
     }
 }

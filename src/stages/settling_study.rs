@@ -6,6 +6,7 @@
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::plot::{Series, XyPlot, xy_png};
+use crate::report::table::{Col, write_table};
 use anyhow::{Result, bail};
 use lbdem_coupling::Method;
 use lbdem_coupling::cases::settling::{self, SettlingSpec};
@@ -123,24 +124,38 @@ impl Stage for SettlingStudy {
             }
         }
         bar.finish_and_clear();
-        let mut csv = String::from(
-            "method,precision,cells_per_diameter,nodes,lbm_steps,velocity,reference,error,wall_seconds\n",
+        let method_names: Vec<String> = points
+            .iter()
+            .map(|q| {
+                if q.method == Method::Psm {
+                    "psm"
+                } else {
+                    "bounce-back"
+                }
+                .to_string()
+            })
+            .collect();
+        let col = |f: fn(&Point) -> f64| points.iter().map(f).collect::<Vec<f64>>();
+        let precision: Vec<String> = points.iter().map(|q| q.precision.clone()).collect();
+        let (cells, nodes, steps): (Vec<u64>, Vec<u64>, Vec<u64>) = (
+            points.iter().map(|q| q.cells_per_diameter as u64).collect(),
+            points.iter().map(|q| q.nodes as u64).collect(),
+            points.iter().map(|q| q.lbm_steps).collect(),
         );
-        for q in &points {
-            csv.push_str(&format!(
-                "{},{},{},{},{},{:e},{:e},{:e},{:e}\n",
-                serde_json::to_value(q.method)?.as_str().unwrap_or("?"),
-                q.precision,
-                q.cells_per_diameter,
-                q.nodes,
-                q.lbm_steps,
-                q.velocity,
-                q.reference,
-                q.error,
-                q.wall_seconds
-            ));
-        }
-        lbdem_core::atomic::write_atomic(&ctx.out_dir.join("settling_study.csv"), csv.as_bytes())?;
+        write_table(
+            &ctx.out_dir.join("settling_study.csv"),
+            &[
+                ("method", Col::Str(&method_names)),
+                ("precision", Col::Str(&precision)),
+                ("cells_per_diameter", Col::U64(&cells)),
+                ("nodes", Col::U64(&nodes)),
+                ("lbm_steps", Col::U64(&steps)),
+                ("velocity", Col::F64(&col(|q| q.velocity))),
+                ("reference", Col::F64(&col(|q| q.reference))),
+                ("error", Col::F64(&col(|q| q.error))),
+                ("wall_seconds", Col::F64(&col(|q| q.wall_seconds))),
+            ],
+        )?;
         // One series per method and precision: x = wall time, y = |error|.
         let mut data: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
         for &method in &p.methods {
