@@ -5,6 +5,7 @@
 //! (`lbdem_core::units::lattice::LatticeUnits::derive`) is asked what it would say of the same
 //! setting. Writes the CSV and one PNG map per collision; `docs/stability.md` reads them.
 
+pub mod dem;
 pub mod lbm;
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
@@ -226,38 +227,66 @@ fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
 }
 
 fn draw(path: &std::path::Path, op: Operator, points: &[Point], p: &Params) -> Result<()> {
-    let cells: Vec<Cell> = points
-        .iter()
-        .filter(|q| q.operator == op)
-        .map(|q| Cell {
-            ix: p.machs.iter().position(|&m| m == q.mach).unwrap_or(0),
-            iy: p.taus.iter().position(|&t| t == q.tau).unwrap_or(0),
-            colour: q.class.colour(),
-            mark: q.verdict.mark(),
-        })
-        .collect();
+    let cells = points.iter().filter(|q| q.operator == op).map(|q| {
+        let ix = p.machs.iter().position(|&m| m == q.mach).unwrap_or(0);
+        let iy = p.taus.iter().position(|&t| t == q.tau).unwrap_or(0);
+        (ix, iy, q.class, q.verdict)
+    });
     let x_ticks: Vec<String> = p.machs.iter().map(|m| format!("{m}")).collect();
     let y_ticks: Vec<String> = p.taus.iter().map(|t| format!("{t}")).collect();
-    let colours: Vec<(&str, (u8, u8, u8))> = CLASSES.iter().map(|c| (c.name(), c.colour())).collect();
-    let marks: Vec<(&str, Mark)> = VERDICTS
-        .iter()
-        .map(|v| {
+    draw_map(
+        path,
+        cells,
+        &format!("Taylor-Green, {}: tau against lattice Mach number", op.name()),
+        "lattice Mach number u0/c_s",
+        "relaxation time tau",
+        &x_ticks,
+        &y_ticks,
+    )
+}
+
+/// A map of (column, row, class, verdict) cells: colour by class, mark by verdict; the legend
+/// lists the verdicts that occur.
+fn draw_map(
+    path: &std::path::Path,
+    cells: impl Iterator<Item = (usize, usize, Class, Verdict)>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    x_ticks: &[String],
+    y_ticks: &[String],
+) -> Result<()> {
+    let cells: Vec<(Cell, Verdict)> = cells
+        .map(|(ix, iy, class, verdict)| {
+            let colour = class.colour();
             (
-                ["check: accepted", "check: warned", "check: refused"][*v as usize],
-                v.mark(),
+                Cell {
+                    ix,
+                    iy,
+                    colour,
+                    mark: verdict.mark(),
+                },
+                verdict,
             )
         })
         .collect();
-    let title = format!("Taylor-Green, {}: tau against lattice Mach number", op.name());
+    let colours: Vec<(&str, (u8, u8, u8))> = CLASSES.iter().map(|c| (c.name(), c.colour())).collect();
+    let marks: Vec<(&str, Mark)> = VERDICTS
+        .iter()
+        .zip(["check: accepted", "check: warned", "check: refused"])
+        .filter(|(v, _)| cells.iter().any(|c| c.1 == **v))
+        .map(|(v, text)| (text, v.mark()))
+        .collect();
+    let cells: Vec<Cell> = cells.into_iter().map(|c| c.0).collect();
     grid_map_png(
         path,
         &cells,
         &GridMap {
-            title: &title,
-            x_label: "lattice Mach number u0/c_s",
-            y_label: "relaxation time tau",
-            x_ticks: &x_ticks,
-            y_ticks: &y_ticks,
+            title,
+            x_label,
+            y_label,
+            x_ticks,
+            y_ticks,
             colours: &colours,
             marks: &marks,
         },
