@@ -101,7 +101,13 @@ fn the_full_float_case_is_refused_at_table_3s_step_and_builds_at_its_own() {
         crate::scenes::run::model(&l, false).map(|_| ())
     };
     let e = format!("{:#}", build(6.66e-4).unwrap_err());
-    for part in ["float.toml", "[lattice] dt = 6.66e-4", "7.644 Pa", "2.23", "1.3986e-4"] {
+    for part in [
+        "float.toml",
+        "[lattice] dt = 6.66e-4",
+        "7.644 Pa",
+        "2.23",
+        "1.3986e-4",
+    ] {
         assert!(e.contains(part), "missing {part}: {e}");
     }
     // 0.80 at 3.996e-4 stopped at t = 0.0995 s when run; refused too

@@ -320,7 +320,7 @@ mod tests {
                 Verdict::Refused if q.tau < 0.5 => assert_eq!(q.class, Class::BlownUp, "{what}"),
                 // Refused for Ma > 0.3 and forced: the check is conservative for the viscosity.
                 // At τ ≥ 0.55 every such run is accurate (ν error at most 0.042, Ma 0.6). Toward
-                // ½ they blow up: TRT at τ ≤ 0.502 (τ ≤ 0.51 from Ma 0.35), BGK at τ ≤ 0.501
+                // ½ they blow up: TRT at τ ≤ 0.502 (at 0.51 from Ma 0.45), BGK at τ ≤ 0.501
                 // (BGK at 0.502 holds to Ma 0.45, ν error 0.024, and blows up at 0.6); in between
                 // they are inaccurate or accurate. The refusal guards against compressibility
                 // errors of order Ma², which this ν measure does not see, so it stays.
