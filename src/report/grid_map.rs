@@ -60,7 +60,7 @@ pub fn grid_map_png(path: &Path, cells: &[Cell], g: &GridMap) -> Result<()> {
             .caption(g.title, (FONT, 18))
             .margin(15)
             .x_label_area_size(45)
-            .y_label_area_size(70)
+            .y_label_area_size(105)
             .build_cartesian_2d(-0.5..nx as f64 - 0.5, -0.5..ny as f64 - 0.5)
             .map_err(de)?;
         let tick = |ticks: &[String], v: f64| {

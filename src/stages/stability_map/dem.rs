@@ -3,12 +3,14 @@
 //! twentieth of the critical step sqrt(m_min/k_max) to several times it, forced past the stepper's
 //! refusal; its coefficient of restitution is compared with a converged run's (dt = dt_crit/200)
 //! and each run classed accurate, inaccurate or blown up, beside what the stepper's check says.
+//! A last row runs a compressed triangular packing (`lbdem_dem::cases::packing`), whose energy
+//! drift shows what six contacts per grain do to the limit.
 
 use super::{Class, Verdict, draw_map};
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::table::{Col, write_table};
 use anyhow::{Result, anyhow, bail};
-use lbdem_dem::cases::head_on;
+use lbdem_dem::cases::{head_on, packing};
 use lbdem_dem::contact::{ElasticPlastic, HertzMindlin, LinearSpringDashpot};
 use lbdem_dem::{Damping, Law};
 use serde::{Deserialize, Serialize};
@@ -78,8 +80,10 @@ pub struct Point {
     pub class: Class,
     pub restitution: f64,
     pub reference: f64,
-    /// Largest overlap over r_eff.
+    /// Largest overlap over r_eff (pairs; NaN for the packing).
     pub max_overlap: f64,
+    /// Largest energy error over the initial kinetic energy (the packing; NaN for pairs).
+    pub energy_error: f64,
     pub steps: u64,
 }
 
@@ -123,12 +127,46 @@ pub fn map(laws: &[Law], ratios: &[f64], speed: f64, accuracy: f64) -> Result<Ve
                 restitution: c.restitution,
                 reference: converged.restitution,
                 max_overlap: c.max_overlap,
+                energy_error: f64::NAN,
                 steps: c.steps,
             });
         }
     }
+    for &ratio in ratios {
+        let d = packing::run(PACKING_K, 8, 8, ratio, 100.0, true, 1)
+            .map_err(|e| anyhow!("dem-step-map: the packing at dt/dt_crit = {ratio}: {e}"))?;
+        let class = if d.energy_error > 100.0 {
+            Class::BlownUp
+        } else if d.energy_error < PACKING_ACCURACY {
+            Class::Accurate
+        } else {
+            Class::Inaccurate
+        };
+        points.push(Point {
+            law: PACKING.into(),
+            ratio,
+            verdict: if ratio > 1.0 {
+                Verdict::Refused
+            } else {
+                Verdict::Accepted
+            },
+            class,
+            restitution: f64::NAN,
+            reference: f64::NAN,
+            max_overlap: f64::NAN,
+            energy_error: d.energy_error,
+            steps: d.steps,
+        });
+    }
     Ok(points)
 }
+
+/// The packing row: 64 disks on a compressed triangular lattice, linear law k = 1e4 N/m, run for
+/// 100 critical steps; blown up when the energy error exceeds 100 initial kinetic energies.
+const PACKING: &str = "linear, packing";
+const PACKING_K: f64 = 1e4;
+/// Largest energy error (over the initial kinetic energy) of an accurate packing run.
+const PACKING_ACCURACY: f64 = 0.05;
 
 pub struct DemStepMap;
 
@@ -175,10 +213,12 @@ impl Stage for DemStepMap {
                 ("restitution", Col::F64(&f(&|q| q.restitution))),
                 ("reference", Col::F64(&f(&|q| q.reference))),
                 ("max_overlap", Col::F64(&f(&|q| q.max_overlap))),
+                ("energy_error", Col::F64(&f(&|q| q.energy_error))),
                 ("steps", Col::U64(&steps)),
             ],
         )?;
-        let names: Vec<String> = p.laws.iter().map(|l| l.name().to_string()).collect();
+        let mut names: Vec<String> = p.laws.iter().map(|l| l.name().to_string()).collect();
+        names.push(PACKING.into());
         let cells = points.iter().map(|q| {
             let ix = p.ratios.iter().position(|&r| r == q.ratio).unwrap_or(0);
             let iy = names.iter().position(|n| *n == q.law).unwrap_or(0);
@@ -188,7 +228,7 @@ impl Stage for DemStepMap {
         draw_map(
             &ctx.out_dir.join("dem_step_map.png"),
             cells,
-            "Head-on collision: DEM step against the critical step",
+            "DEM step against the critical step: head-on pairs and a packing",
             "dt / dt_crit (dt_crit = sqrt(m_min/k_max))",
             "contact law",
             &x_ticks,
@@ -199,9 +239,11 @@ impl Stage for DemStepMap {
             figures: vec![Figure {
                 path: "dem_step_map.png".into(),
                 caption: format!(
-                    "Two disks meeting head on at {} m/s, per contact law, at each dt/dt_crit, run whatever the \
-                     stepper's check says. Colour: accurate (restitution within {} % of the run at dt_crit/200), \
-                     inaccurate, blown up. A cross where the stepper refuses the step.",
+                    "Two disks meeting head on at {} m/s, per contact law, and a compressed triangular packing of \
+                     64 disks (linear law, undamped), at each dt/dt_crit, run whatever the stepper's check says. \
+                     Colour: accurate (restitution within {} % of the run at dt_crit/200; packing: energy error \
+                     below 5 % of the initial kinetic energy), inaccurate, blown up. A cross where the stepper \
+                     refuses the step.",
                     p.speed,
                     p.accuracy * 100.0
                 ),
@@ -224,12 +266,13 @@ mod tests {
     #[test]
     fn the_critical_step_check_agrees_with_the_map() {
         let pts = map(&laws(), &ratios(), speed(), accuracy()).unwrap();
-        assert_eq!(pts.len(), 3 * 15);
-        for q in &pts {
+        assert_eq!(pts.len(), 4 * 15);
+        for q in pts.iter().filter(|q| q.law != PACKING) {
             let what = format!("{q:?}");
-            // A step the stepper accepts never blows up. Up to dt_crit/2 it is accurate
-            // (largest restitution error measured 1.2 %, plastic at 0.5); from 0.7 the contact
-            // is resolved by 3-5 steps and the restitution is off by up to 55 % (plastic at 1.0).
+            // A step the stepper accepts never blows up a colliding pair. Up to dt_crit/2 it is
+            // accurate (largest restitution error measured 1.2 %, plastic at 0.5); from 0.7 the
+            // contact is resolved by 3-5 steps and the restitution is off by up to 55 % (plastic
+            // at 1.0).
             assert_eq!(q.verdict == Verdict::Accepted, q.ratio <= 1.0, "{what}");
             if q.verdict == Verdict::Accepted {
                 assert_ne!(q.class, Class::BlownUp, "{what}");
@@ -240,8 +283,7 @@ mod tests {
             // Refused steps: at 3 dt_crit every law blows up (restitution 2.1-8.8). An isolated
             // pair is more forgiving than the refusal: m* = m/2 puts the undamped linear pair's
             // Verlet limit at √2 dt_crit, and measured, no law blows up below 1.5 dt_crit
-            // (linear from 1.5, Hertz and elastic-plastic only at 3). The refusal stays at 1:
-            // a disk held by several contacts sees a stiffer spring than the pair does.
+            // (linear from 1.5, Hertz and elastic-plastic only at 3).
             if q.ratio >= 3.0 {
                 assert_eq!(q.class, Class::BlownUp, "{what}");
             }
@@ -249,6 +291,30 @@ mod tests {
                 assert_ne!(q.class, Class::BlownUp, "{what}");
             }
         }
+        // The packing: where the check is wrong. Each disk of a compressed triangular lattice is
+        // held by six springs, its fastest mode has ω² ≈ 6 k/m (measured edge between 0.80 and
+        // 0.85 dt_crit in 100 critical steps; 2/√6 = 0.82), so steps the check ACCEPTS, 0.9 and
+        // 1.0 dt_crit, blow up (energy error 5e5 and 1e6 initial kinetic energies). Energy error
+        // measured 0.032 at 0.2, 0.23 at 0.5, 0.85 at 0.7 (Verlet's error on the fastest mode).
+        for q in pts.iter().filter(|q| q.law == PACKING) {
+            let what = format!("{q:?}");
+            let want = match q.ratio {
+                r if r <= 0.2 => Class::Accurate,
+                r if r <= 0.7 => Class::Inaccurate,
+                _ => Class::BlownUp,
+            };
+            assert_eq!(q.class, want, "{what}");
+        }
+        let accepted_blown = pts
+            .iter()
+            .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)
+            .map(|q| q.ratio)
+            .collect::<Vec<_>>();
+        assert_eq!(
+            accepted_blown,
+            [0.9, 1.0],
+            "accepted steps that blew up: {accepted_blown:?}"
+        );
     }
 
     #[test]
@@ -257,7 +323,7 @@ mod tests {
         let ctx = StageContext::new(dir.path().to_path_buf(), "dem".into(), dir.path().to_path_buf());
         let p: Params = toml::from_str("ratios = [0.1, 1.2, 3.0]").unwrap();
         let out = DemStepMap::run(&p, &ctx).unwrap();
-        assert_eq!(out.summary["points"].as_array().unwrap().len(), 9);
+        assert_eq!(out.summary["points"].as_array().unwrap().len(), 12);
         assert!(dir.path().join("dem_step_map.png").exists());
         let bad: Params = toml::from_str("ratios = [-1.0]").unwrap();
         let e = DemStepMap::run(&bad, &ctx).unwrap_err().to_string();

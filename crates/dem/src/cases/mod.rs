@@ -2,3 +2,4 @@
 //! each returns what it measured; callers judge, draw and write.
 
 pub mod head_on;
+pub mod packing;
