@@ -48,6 +48,8 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::assemble::Assemble>(&["assemble"], CliShape::ParamsFile),
     entry::<stages::simulate::Simulate>(&["simulate"], CliShape::SceneFile),
     entry::<stages::settling_study::SettlingStudy>(&["settling-study"], CliShape::ParamsFile),
+    entry::<stages::stability_map::StabilityMap>(&["stability-map"], CliShape::ParamsFile),
+    entry::<stages::stability_map::dem::DemStepMap>(&["dem-step-map"], CliShape::ParamsFile),
     entry::<stages::report::Report>(&["report"], CliShape::ParamsFile),
     entry::<stages::analyse::Analyse>(&["analyse"], CliShape::ParamsFile),
     entry::<stages::synth_run::SynthRun>(&["synth", "run"], CliShape::ParamsFile),

@@ -24,7 +24,8 @@ pub fn model(l: &Loaded, resume: bool) -> Result<Box<dyn Model>> {
     Ok(match l.physics {
         Physics::Dry => Box::new(models::dry::Dry::build(&l.scene, &l.base_dir, !resume)?),
         Physics::Fluid => models::fluid::build(&l.scene, &l.base_dir)?,
-        Physics::Coupled => models::coupled::build(&l.scene, &l.base_dir)?,
+        Physics::Coupled => models::coupled::build(&l.scene, &l.base_dir)
+            .with_context(|| format!("scene {} refused", l.path.display()))?,
     })
 }
 

@@ -14,6 +14,7 @@ pub mod report;
 pub mod run_data;
 pub mod settling_study;
 pub mod simulate;
+pub mod stability_map;
 pub mod strain_fields;
 pub mod synth;
 pub mod synth_run;

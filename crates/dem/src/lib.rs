@@ -8,6 +8,7 @@
 
 pub mod assembly;
 pub mod body;
+pub mod cases;
 pub mod contact;
 pub mod domain;
 pub mod error;

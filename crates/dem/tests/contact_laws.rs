@@ -1,35 +1,16 @@
 //! Contact laws against analytic results (references cited per test).
 
-mod common;
-use common::two;
+use lbdem_dem::cases::head_on;
 use lbdem_dem::contact::plastic::su_yield_force;
 use lbdem_dem::contact::{Bond, BondParams, ContactInput, ElasticPlastic, HertzMindlin, LinearSpringDashpot};
 use lbdem_dem::*;
 
-/// Run a head-on collision of two disks (radius 0.5, density 1) at relative speed `v`;
-/// returns (relative speed after / before, contact duration).
+/// A head-on collision of two disks (radius 0.5, density 1) at relative speed `v`
+/// (`lbdem_dem::cases::head_on`); returns (relative speed after / before, contact duration).
 fn collide<L: ContactLaw>(law: &L, v: f64, dt: f64) -> (f64, f64) {
-    let d = ClumpShape::disk(0.5);
-    // Start a hair apart so the run is the contact itself.
-    let x0 = 0.5 + 0.25 * v * dt;
-    let mut s = two(&d, &d, Vec2::new(-x0, 0.0), Vec2::new(x0, 0.0));
-    s.bodies.vel[0] = Vec2::new(0.5 * v, 0.0);
-    s.bodies.vel[1] = Vec2::new(-0.5 * v, 0.0);
-    let p = StepParams::new(dt, 0.05);
-    let mut st = Stepper::new();
-    let (mut touched, mut t_touch) = (0u64, false);
-    for _ in 0..10_000_000 {
-        st.step(&p, law, law, &mut s).unwrap();
-        let gap = (s.bodies.pos[1] - s.bodies.pos[0]).norm() - 1.0;
-        if gap < 0.0 {
-            touched += 1;
-            t_touch = true;
-        } else if t_touch {
-            break;
-        }
-    }
-    let vr = s.bodies.vel[1].x - s.bodies.vel[0].x;
-    (vr / v, touched as f64 * dt)
+    let c = head_on::run(law, v, dt, false, 10_000_000).unwrap();
+    assert!(c.finished, "{c:?}");
+    (c.restitution, c.duration)
 }
 
 /// REFERENCES.md (DEM, linear spring-dashpot): e = exp(−πζ/√(1−ζ²)) and

@@ -42,6 +42,16 @@ impl Collision {
         if tau.is_nan() || tau <= 0.5 || !tau.is_finite() {
             return Err(LbmError::Tau { tau });
         }
+        self.rates_past_tau_check()
+    }
+    /// (ω⁺, ω⁻) for any finite τ ≠ ½, τ < ½ included (ω > 2, negative viscosity): only for the
+    /// stability maps, which must run a refused τ to show the refusal was right
+    /// (`cases::taylor_green` with `force_past_refusal`). Λ ≤ 0 is still refused.
+    pub fn rates_past_tau_check(&self) -> Result<(f64, f64), LbmError> {
+        let tau = self.tau();
+        if tau.is_nan() || tau == 0.5 || !tau.is_finite() {
+            return Err(LbmError::Tau { tau });
+        }
         match *self {
             Collision::Bgk { .. } => Ok((1.0 / tau, 1.0 / tau)),
             Collision::Trt { magic, .. } => {
@@ -85,7 +95,11 @@ pub struct CollideParams<T> {
 impl<T: Real> CollideParams<T> {
     pub fn new(c: &Collision, force: [f64; 3]) -> Result<Self, LbmError> {
         let (wp, wm) = c.rates()?;
-        Ok(Self {
+        Ok(Self::from_rates(wp, wm, force))
+    }
+    /// The constants of the rates (ω⁺, ω⁻), whatever they are.
+    pub fn from_rates(wp: f64, wm: f64, force: [f64; 3]) -> Self {
+        Self {
             omega_p: T::from_f64(wp),
             omega_m: T::from_f64(wm),
             force_p: T::from_f64(1.0 - 0.5 * wp),
@@ -93,7 +107,7 @@ impl<T: Real> CollideParams<T> {
             force: force.map(T::from_f64),
             bgk: wp == wm,
             keep: T::from_f64(1.0 - wp),
-        })
+        }
     }
 }
 

@@ -11,6 +11,7 @@
 // loop says that more plainly than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
+pub mod cases;
 pub mod collision;
 pub mod diagnosis;
 pub mod domain;

@@ -161,6 +161,26 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
     /// Check the settings against the domain and build the row plan.
     pub fn new(fluid: &Fluid<L, T>, settings: Settings) -> Result<Self, LbmError> {
         let params = CollideParams::<T>::new(&settings.collision, settings.force)?;
+        Self::with_params(fluid, settings, params)
+    }
+
+    /// As [`Stepper::new`] but running a τ < ½ that `new` refuses (see
+    /// [`Collision::rates_past_tau_check`]): only for the stability maps, to show by running that
+    /// the refusal was right. The run still stops at the first node leaving `settings.limits`.
+    pub fn new_past_tau_check(fluid: &Fluid<L, T>, settings: Settings) -> Result<Self, LbmError> {
+        let (wp, wm) = settings.collision.rates_past_tau_check()?;
+        Self::with_params(
+            fluid,
+            settings,
+            CollideParams::<T>::from_rates(wp, wm, settings.force),
+        )
+    }
+
+    fn with_params(
+        fluid: &Fluid<L, T>,
+        settings: Settings,
+        params: CollideParams<T>,
+    ) -> Result<Self, LbmError> {
         let dom = &fluid.domain;
         if (L::D == 2) != (dom.n[2] == 1) {
             return Err(LbmError::Unsupported(format!(

@@ -10,10 +10,8 @@
 #![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
-use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, LbmError, Macro, Stepper};
-use std::f64::consts::PI;
-
-use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
+use lbdem_lbm::cases::taylor_green::{self, Spec, Verdict};
+use lbdem_lbm::{Collision, D2Q9, Fluid, LbmError, Stepper};
 
 enum Outcome {
     Accurate(f64),
@@ -22,57 +20,22 @@ enum Outcome {
     Refused(String),
 }
 
-/// Taylor-Green on 32x32 with amplitude u0 and the given collision; ν error bound 5 %.
+/// Taylor-Green on 32x32 with amplitude u0 and the given collision (`lbdem_lbm::cases`), as the
+/// set-up check and then the engine see it; ν error bound 5 %.
 fn tg(collision: Collision, u0: f64) -> Outcome {
-    let l = 32;
-    let k = 2.0 * PI / l as f64;
-    let mut fl = Fluid::<D2Q9, f64>::new(Domain::periodic([l, l, 1]), no_obstacles());
-    fl.init_equilibrium(|p| {
-        let (x, y) = (p[0] as f64, p[1] as f64);
-        let u = [
-            -u0 * (k * x).cos() * (k * y).sin(),
-            u0 * (k * x).sin() * (k * y).cos(),
-            0.0,
-        ];
-        (
-            1.0 - 0.75 * u0 * u0 * ((2.0 * k * x).cos() + (2.0 * k * y).cos()),
-            u,
-        )
-    });
-    // lattice units: dx = dt = 1, viscosity from tau, rho = 1
-    let inp = LatticeInput::new(1.0, collision.nu(), 1.0, u0, TimeSpec::Tau(collision.tau()));
-    let warned = match LatticeUnits::derive(&inp) {
-        Ok(units) => !units.warnings.is_empty(),
-        Err(e) => return Outcome::Refused(e.to_string()),
+    let warned = match taylor_green::setup_verdict(collision, u0) {
+        Verdict::Accepted => false,
+        Verdict::Warned(_) => true,
+        Verdict::Refused(e) => return Outcome::Refused(e),
     };
-    let mut st = match Stepper::new(&fl, settings(collision, [0.0; 3])) {
-        Ok(s) => s,
-        Err(e) => return Outcome::Refused(e.to_string()),
-    };
-    let nu = collision.nu();
-    // start after the initial non-equilibrium transient: ten times the slower relaxation time
-    let t1 = match collision.rates() {
-        Ok((wp, wm)) => (10.0 / wp.min(wm)).max(50.0) as usize,
-        Err(_) => 50,
-    };
-    let t2 = t1 + ((0.5 / (nu * k * k)) as usize).clamp(50, 4000);
-    let mut m = Macro::default();
-    let mut e = [0.0; 2];
-    for s in 1..=t2 {
-        let want = s == t1 || s == t2;
-        if let Err(err) = st.step(&mut fl, if want { Some(&mut m) } else { None }) {
-            return Outcome::Stopped(err);
-        }
-        if want {
-            e[usize::from(s == t2)] = m.u.iter().map(|v| v * v).sum();
-        }
-    }
-    let nu_meas = (e[0] / e[1]).ln() / (4.0 * k * k * (t2 - t1) as f64);
-    let err = (nu_meas - nu).abs() / nu;
-    if warned {
-        Outcome::Warned(err)
-    } else {
-        Outcome::Accurate(err)
+    match taylor_green::run(&Spec::new(collision, u0)) {
+        Err(e) => Outcome::Refused(e.to_string()),
+        Ok(r) => match (r.stopped, r.nu_error) {
+            (Some(e), _) => Outcome::Stopped(e),
+            (None, Some(err)) if warned => Outcome::Warned(err),
+            (None, Some(err)) => Outcome::Accurate(err),
+            (None, None) => unreachable!("a finished run has a nu error"),
+        },
     }
 }
 

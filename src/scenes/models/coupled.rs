@@ -14,6 +14,7 @@ use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::{FluidFields, write_fluid, write_particles};
 use crate::scenes::timeloop::{Model, Probe};
 use anyhow::{Context, Result, bail};
+use lbdem_core::units::coupled::{LOAD_DENSITY_MAX, buoyant_load};
 use lbdem_coupling::bounce::BounceFluid;
 use lbdem_coupling::units::CouplingUnits;
 use lbdem_coupling::{Coupled, Hydro, Method, PsmFluid, PsmSettings};
@@ -108,6 +109,7 @@ impl<T: Real> CoupledModel<T> {
             );
         }
         let sys = super::grains(s, base)?;
+        pressure_load(s, &sys, &units, cs.depth)?;
         let [nx, ny, _] = su.n;
         let domain = Domain::new(su.n, su.faces);
         let tau = su.units.tau;
@@ -450,4 +452,44 @@ impl<T: Real> Model for CoupledModel<T> {
         }
         Ok(())
     }
+}
+
+/// Refuse a scene whose grains' buoyant weight the lattice cannot carry: the pressure difference
+/// [`buoyant_load`] as a density change at this step's pressure unit c_s² ρ_L (dx/δt)² must stay
+/// below [`LOAD_DENSITY_MAX`] (the full Float case at Table 3's δt needs 2.2 and stops at LBM step
+/// 94; docs/stability.md). The load goes with δt², so the fix is a smaller `[lattice] dt`.
+fn pressure_load(s: &Scene, sys: &lbdem_dem::System, units: &CouplingUnits, depth: f64) -> Result<()> {
+    let Some(dem) = &s.dem else { return Ok(()) };
+    let accel = [
+        dem.gravity[0] * dem.gravity_factor,
+        dem.gravity[1] * dem.gravity_factor,
+    ];
+    // the real masses: mass scaling (a quasi-static device) does not change what the liquid carries
+    let mass = sys.bodies.mass.iter().sum::<f64>() / dem.mass_scale;
+    let size = [s.domain.size(0), s.domain.size(1)];
+    let load = buoyant_load(mass, accel, size, depth);
+    let drho = units.lattice.pressure_to_density(load);
+    if drho > LOAD_DENSITY_MAX {
+        // Δρ ∝ δt²: the largest whole multiple of the DEM step that brings it to a fifth of the limit
+        let fix = units.dt() * (0.2 * LOAD_DENSITY_MAX / drho).sqrt();
+        let fix = (fix / units.dt_dem).floor().max(1.0) * units.dt_dem;
+        bail!(
+            "[lattice] dt = {:e} s: the grains' buoyant weight needs the liquid to carry a pressure difference \
+             of about {load:.3} Pa (|rho_S - rho_L| g x solid fraction x packing height), a density change \
+             of {drho:.2} at this step's pressure unit c_s^2 rho_L (dx/dt)^2 = {:.3} Pa; above {LOAD_DENSITY_MAX} \
+             the lattice cannot carry it (the run would stop on a density below 0.5, docs/stability.md). \
+             Lower [lattice] dt, e.g. to {fix:e} s (a whole multiple of [dem] dt; the change goes with dt^2)",
+            units.dt(),
+            units.lattice.density_to_pressure(2.0),
+        );
+    }
+    if drho > 0.2 * LOAD_DENSITY_MAX {
+        eprintln!(
+            "coupled: warning: the grains' buoyant weight ({load:.3} Pa) is a density change of {drho:.2} at \
+             [lattice] dt = {:e} s; the Float case's grains move up to 1.5 times faster at 0.2 than at 0.09 \
+             (docs/stability.md): lower dt for a converged answer",
+            units.dt()
+        );
+    }
+    Ok(())
 }

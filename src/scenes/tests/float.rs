@@ -86,3 +86,31 @@ fn a_second_area_cut_continues_from_the_last_snapshot_and_floats_again() {
         "packed fraction after the second cut {frac}"
     );
 }
+
+/// The liquid's pressure load (issue 16 item 2, docs/stability.md): the full Float case's
+/// packing weighs 7.64 Pa buoyant, a density change of 2.23 at Table 3's δt = 6.66e-4 s (the run
+/// stops at LBM step 94) and of 0.089 at the scene's own 1.332e-4 s (runs). The check refuses
+/// the first before anything runs, names the file, the parameter and a smaller step, and builds
+/// the second.
+#[test]
+fn the_full_float_case_is_refused_at_table_3s_step_and_builds_at_its_own() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/su2020/float.toml");
+    let build = |dt: f64| {
+        let over: toml::Table = toml::from_str(&format!("lattice = {{ dt = {dt:e} }}")).unwrap();
+        let l = crate::scenes::schema::load(&p, &over).unwrap();
+        crate::scenes::run::model(&l, false).map(|_| ())
+    };
+    let e = format!("{:#}", build(6.66e-4).unwrap_err());
+    for part in [
+        "float.toml",
+        "[lattice] dt = 6.66e-4",
+        "7.644 Pa",
+        "2.23",
+        "1.3986e-4",
+    ] {
+        assert!(e.contains(part), "missing {part}: {e}");
+    }
+    // 0.80 at 3.996e-4 stopped at t = 0.0995 s when run; refused too
+    assert!(build(3.996e-4).is_err());
+    build(1.332e-4).unwrap();
+}

@@ -76,6 +76,29 @@ impl CouplingUnits {
     }
 }
 
+/// Largest density change Δρ/ρ a scene may need the liquid to carry its grains' buoyant weight
+/// ([`buoyant_load`] through [`LatticeUnits::pressure_to_density`]): above it a coupled scene is
+/// refused before it starts. Found by running the full Float case of Su et al. 2020
+/// (`scenes/su2020/float.toml`, docs/stability.md "The liquid's pressure load").
+pub const LOAD_DENSITY_MAX: f64 = 0.5;
+
+/// The pressure difference (Pa) the liquid must carry when the grains move through it as one
+/// packing: their buoyant weight over the box's width, Δp = Σ m_i |a| / (W d), with `mass` the
+/// grains' total mass (kg, over the sample depth `depth`, m), `accel` the net acceleration the DEM
+/// gives them (gravity × the buoyancy factor 1 − ρ_L/ρ_S, m/s²), and W the box's extent across
+/// `accel` (`size` = the box's sides, m). For a packing of solid fraction φ and height H this is
+/// |ρ_S − ρ_L| g φ H, the pressure difference that drives the liquid's counter-flow through it.
+pub fn buoyant_load(mass: f64, accel: [f64; 2], size: [f64; 2], depth: f64) -> f64 {
+    let a = accel[0].hypot(accel[1]);
+    if a == 0.0 {
+        return 0.0;
+    }
+    // the box's extent along the acceleration, and so its width across it
+    let along = (accel[0].abs() * size[0] + accel[1].abs() * size[1]) / a;
+    let width = size[0] * size[1] / along;
+    mass * a / (width * depth)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -109,5 +132,24 @@ mod tests {
         let p = u.position_to_lattice([1.0 + 40e-6, 2.0]);
         assert!((p[0] - 1.0).abs() <= 1e-9, "{}", p[0]);
         assert_eq!(p[1], 0.0);
+    }
+
+    #[test]
+    fn buoyant_load_of_the_float_packing() {
+        // Su et al. 2020 Float: ρ_S = 2634, ρ_L = 2856 kg/m³, a 5 mm packing at φ = 0.7 in a
+        // 10 mm box, 0.2 mm deep: |ρ_S − ρ_L| g φ H = 222 × 9.81 × 0.7 × 5e-3 = 7.62 Pa.
+        let (w, h, d, phi) = (0.010, 0.005, 2e-4, 0.7);
+        let mass = 2634.0 * phi * w * h * d;
+        let a = 9.81 * (1.0 - 2856.0 / 2634.0);
+        let p = buoyant_load(mass, [0.0, -a], [w, h], d);
+        assert!((p - 222.0 * 9.81 * phi * h).abs() < 1e-9, "{p}");
+        // the same along x: the width is then the box's height
+        assert!((buoyant_load(mass, [a, 0.0], [h, w], d) - p).abs() < 1e-9);
+        assert_eq!(buoyant_load(mass, [0.0, 0.0], [w, h], d), 0.0);
+        // Table 3's step: pressure unit ρ_L (dx/δt)² = 10.3 Pa, Δρ/ρ = Δp/(c_s² 10.3) ≈ 2.2
+        let inp = |dt| LatticeInput::new(4e-5, 1.82e-3 / 2856.0, 2856.0, 2e-3, TimeSpec::Dt(dt));
+        let drho = |dt| LatticeUnits::derive(&inp(dt)).unwrap().pressure_to_density(p);
+        assert!((drho(6.66e-4) - 2.22).abs() < 0.01, "{}", drho(6.66e-4));
+        assert!(drho(6.66e-4) > LOAD_DENSITY_MAX && drho(1.332e-4) < LOAD_DENSITY_MAX);
     }
 }
