@@ -72,18 +72,31 @@ fn the_ci_sweep_runs_the_reduced_matrix_and_a_rerun_reuses_every_case() {
     );
 }
 
-/// sweeps/su2020-reduced-replicas.toml with three replicas instead of eight.
-#[test]
-fn replicas_of_the_reduced_cell_give_a_spread_of_the_strain_and_its_interval() {
+/// Run a repository sweep file with `edits` (text replacements) applied, from a temporary copy
+/// whose pipeline path points back into the repository; returns the temporary directory (keep
+/// it alive), the output directory, whether the sweep succeeded and its stderr.
+fn run_edited_sweep(file: &str, edits: &[(&str, &str)]) -> (tempfile::TempDir, PathBuf, bool, String) {
     let t = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(repo("sweeps/su2020-reduced-replicas.toml"))
-        .unwrap()
-        .replace("count = 8", "count = 3")
-        .replace("\"../pipelines/", &format!("\"{}/", repo("pipelines").display()));
-    let f = t.path().join("replicas.toml");
+    let mut text = std::fs::read_to_string(repo(file)).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{file} no longer holds {from:?}");
+        text = text.replace(from, to);
+    }
+    let text = text.replace("\"../pipelines/", &format!("\"{}/", repo("pipelines").display()));
+    let f = t.path().join("sweep.toml");
     std::fs::write(&f, text).unwrap();
     let out = t.path().join("out");
     let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    (t, out, ok, err)
+}
+
+/// sweeps/su2020-reduced-replicas.toml with three replicas instead of eight.
+#[test]
+fn replicas_of_the_reduced_cell_give_a_spread_of_the_strain_and_its_interval() {
+    let (_t, out, ok, err) = run_edited_sweep(
+        "sweeps/su2020-reduced-replicas.toml",
+        &[("count = 8", "count = 3")],
+    );
     assert!(ok, "{err}");
     let res = out.join("results.csv");
     assert_eq!(numbers(&res, "seed"), [1.0, 2.0, 3.0]);
@@ -161,18 +174,16 @@ struct Shift {
 
 /// sweeps/su2020-mass-scaling.toml with `replicas` assemblies: the shift of each.
 fn mass_scaling_pairs(replicas: usize) -> Vec<Shift> {
-    let t = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(repo("sweeps/su2020-mass-scaling.toml"))
-        .unwrap()
-        .replace("count = 16", &format!("count = {replicas}"))
-        // f = 10 is the atlas's (docs/atlas.md); the check compares 100 with 1.
-        .replace("values = [1.0, 10.0, 100.0]", "values = [1.0, 100.0]")
-        .replace("[4.0e-6, 1.25e-5, 5.0e-5]", "[4.0e-6, 5.0e-5]")
-        .replace("\"../pipelines/", &format!("\"{}/", repo("pipelines").display()));
-    let f = t.path().join("mass.toml");
-    std::fs::write(&f, text).unwrap();
-    let out = t.path().join("out");
-    let (ok, err) = run(&["sweep", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let count = format!("count = {replicas}");
+    // f = 10 is the atlas's (docs/atlas.md); the check compares 100 with 1.
+    let (_t, out, ok, err) = run_edited_sweep(
+        "sweeps/su2020-mass-scaling.toml",
+        &[
+            ("count = 16", &count),
+            ("values = [1.0, 10.0, 100.0]", "values = [1.0, 100.0]"),
+            ("[4.0e-6, 1.25e-5, 5.0e-5]", "[4.0e-6, 5.0e-5]"),
+        ],
+    );
     // Every case finishes: at f = 1 two of six blew up while the replica pipeline left the
     // assemblies compressed and the plate inside the bottom row.
     assert!(ok, "{err}");

@@ -2,7 +2,6 @@
 //! with a published or converged answer, each one point (error, wall time), and the
 //! non-dominated settings among them. The studies compute; the `tradeoffs` stage writes.
 
-pub mod channel;
 pub mod chart;
 pub mod pareto;
 pub mod studies;

@@ -3,14 +3,13 @@
 //! measure.
 
 use super::Point;
-use super::channel::poiseuille;
-use crate::report::table::{f64_column, read_table};
+use crate::report::table::{f64_column, read_table, str_column};
 use anyhow::{Context, Result, bail};
 use lbdem_coupling::Method;
-use lbdem_coupling::cases::resolution::{Steady, disk_array, offsets, sangani_acrivos};
+use lbdem_coupling::cases::resolution::{Steady, disk_array, offsets, offsets_at, sangani_acrivos};
 use lbdem_coupling::cases::settling::{self, SettlingSpec};
 use lbdem_lbm::Collision;
-use polars::prelude::DataType;
+use lbdem_lbm::cases::poiseuille::poiseuille;
 use std::path::Path;
 
 /// Lattice resolution: Stokes drag of a square array of disks at solid fraction `phi` against
@@ -28,14 +27,7 @@ pub fn resolution(cells: &[f64], phi: f64) -> Result<Vec<Point>> {
     cells
         .iter()
         .map(|&n| {
-            let k = if n <= 10.0 {
-                3
-            } else if n <= 20.0 {
-                2
-            } else {
-                1
-            };
-            let runs = offsets(k)
+            let runs = offsets(offsets_at(n))
                 .into_iter()
                 .map(|o| disk_array(phi, n, o, 1.0, &steady))
                 .collect::<Result<Vec<_>, _>>()
@@ -151,21 +143,14 @@ pub fn paired(study: &str, sweep: &Path, axis: &str, reference: f64, result: &st
     }
     let res = read_table(&res_path)?;
     let cases = read_table(&cases_path)?;
-    let strings = |df: &polars::prelude::DataFrame, name: &str, path: &Path| -> Result<Vec<String>> {
-        let c = df
-            .column(name)
-            .map_err(|_| anyhow::anyhow!("table {} has no column '{name}'", path.display()))?
-            .cast(&DataType::String)?;
-        Ok(c.str()?.iter().map(|v| v.unwrap_or("").to_string()).collect())
-    };
     let (case, knob, replica, value) = (
-        strings(&res, "case", &res_path)?,
+        str_column(&res, "case", &res_path)?,
         f64_column(&res, axis, &res_path)?,
         f64_column(&res, "replica", &res_path)?,
         f64_column(&res, result, &res_path)?,
     );
     let (wall_case, wall) = (
-        strings(&cases, "case", &cases_path)?,
+        str_column(&cases, "case", &cases_path)?,
         f64_column(&cases, "wall_s", &cases_path)?,
     );
     let wall_of = |c: &str| wall_case.iter().position(|w| w == c).map(|k| wall[k]);

@@ -20,8 +20,8 @@ use crate::report::plot::{Series, XyPlot, xy_png};
 use crate::report::table::{Col, write_table};
 use anyhow::{Context, Result};
 use lbdem_coupling::cases::resolution::{
-    PAPER_CELLS, R_HD, Steady, disk_array, offsets, packing_permeability, sangani_acrivos, spread,
-    two_circle_packing,
+    PAPER_CELLS, R_HD, Steady, disk_array, offsets, offsets_at, packing_permeability, sangani_acrivos,
+    spread, two_circle_packing,
 };
 use std::path::PathBuf;
 
@@ -36,17 +36,6 @@ const TAU: f64 = 1.0;
 const TAUS_SU: [f64; 3] = [0.59, 1.25, 1.57];
 /// Seed of the packed assembly.
 const SEED: u64 = 7;
-
-/// Sub-cell offsets per axis at `n` cells per diameter.
-fn offsets_at(n: f64) -> usize {
-    if n <= 10.0 {
-        3
-    } else if n <= 20.0 {
-        2
-    } else {
-        1
-    }
-}
 
 /// A chart line: label, cells per diameter, wall time (s), |error| (%).
 type Curve = (String, Vec<f64>, Vec<f64>, Vec<f64>);

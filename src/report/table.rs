@@ -93,6 +93,15 @@ pub fn f64_column(df: &DataFrame, name: &str, path: &Path) -> Result<Vec<f64>> {
     Ok(c.f64()?.iter().map(|v| v.unwrap_or(f64::NAN)).collect())
 }
 
+/// Column `name` of `df` as text (numbers are printed; empty cells become "").
+pub fn str_column(df: &DataFrame, name: &str, path: &Path) -> Result<Vec<String>> {
+    let c = df
+        .column(name)
+        .map_err(|_| anyhow::anyhow!("table {} has no column '{name}'", path.display()))?
+        .cast(&DataType::String)?;
+    Ok(c.str()?.iter().map(|v| v.unwrap_or("").to_string()).collect())
+}
+
 /// Column `name` of `df` as u64.
 pub fn u64_column(df: &DataFrame, name: &str, path: &Path) -> Result<Vec<u64>> {
     let c = df

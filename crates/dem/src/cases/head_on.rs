@@ -63,6 +63,15 @@ pub fn run<L: ContactLaw>(
     } else {
         Stepper::new()
     };
+    // What the pair did, measured when it parted or the steps ran out.
+    let outcome = |s: &System, touching: u64, max_overlap: f64, steps: u64, finished: bool| Collision {
+        restitution: (s.bodies.vel[1].x - s.bodies.vel[0].x) / v,
+        duration: touching as f64 * dt,
+        max_overlap,
+        critical,
+        steps,
+        finished,
+    };
     let (mut touching, mut touched, mut max_overlap) = (0u64, false, 0.0f64);
     let r_eff = 0.5 * RADIUS;
     for k in 1..=max_steps {
@@ -86,24 +95,10 @@ pub fn run<L: ContactLaw>(
             touched = true;
             max_overlap = max_overlap.max(overlap / r_eff);
         } else if touched {
-            return Ok(Collision {
-                restitution: (s.bodies.vel[1].x - s.bodies.vel[0].x) / v,
-                duration: touching as f64 * dt,
-                max_overlap,
-                critical,
-                steps: k,
-                finished: true,
-            });
+            return Ok(outcome(&s, touching, max_overlap, k, true));
         }
     }
-    Ok(Collision {
-        restitution: (s.bodies.vel[1].x - s.bodies.vel[0].x) / v,
-        duration: touching as f64 * dt,
-        max_overlap,
-        critical,
-        steps: max_steps,
-        finished: false,
-    })
+    Ok(outcome(&s, touching, max_overlap, max_steps, false))
 }
 
 #[cfg(test)]

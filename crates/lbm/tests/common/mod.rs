@@ -1,7 +1,7 @@
 //! Shared helpers of the validation tests.
 #![allow(dead_code)]
 
-use lbdem_lbm::{Collision, Domain, Face, Fluid, Lattice, Limits, Macro, Motion, Real, Settings, Stepper};
+use lbdem_lbm::{Collision, Fluid, Lattice, Limits, Macro, Motion, Real, Settings, Stepper};
 
 pub fn settings(collision: Collision, force: [f64; 3]) -> Settings {
     Settings {
@@ -44,21 +44,8 @@ pub fn run_steady<L: Lattice, T: Real>(
     (m, steps)
 }
 
-/// Channel periodic in x, walls at y = -1/2 and y = H - 1/2 (halfway bounce-back).
-pub fn channel(nx: usize, h: usize) -> Domain {
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    Domain::new(
-        [nx, h, 1],
-        [
-            Face::Periodic,
-            Face::Periodic,
-            wall,
-            wall,
-            Face::Periodic,
-            Face::Periodic,
-        ],
-    )
-}
+#[allow(unused_imports)] // not every test binary uses it
+pub use lbdem_lbm::cases::poiseuille::channel;
 
 pub fn no_obstacles() -> Vec<Motion> {
     Vec::new()

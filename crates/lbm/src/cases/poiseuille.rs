@@ -1,10 +1,10 @@
 //! Plane Poiseuille flow between halfway bounce-back walls, driven by a body force: the BGK
-//! against TRT case of the atlas. Reference (REFERENCES.md, LBM): u(y) = g (h²/4 − y²) / (2ν).
+//! against TRT case of the atlas (and the channel of the slip tests, tests/poiseuille.rs). Reference (REFERENCES.md, LBM): u(y) = g (h²/4 − y²) / (2ν).
 //! Halfway bounce-back puts the wall where the collision's Λ says: BGK (Λ = (τ − ½)²) slips by
 //! (g/ν)(16Λ − 3)/24, growing with τ; TRT with Λ = 3/16 puts it on the halfway plane at any τ
 //! (Ginzburg & Adler, J. Phys. II France 4 (1994) 191). No I/O.
 
-use lbdem_lbm::{Collision, D2Q9, Domain, Face, Fluid, LbmError, Limits, Macro, Settings, Stepper};
+use crate::{Collision, D2Q9, Domain, Face, Fluid, LbmError, Limits, Macro, Settings, Stepper};
 use std::time::Instant;
 
 /// One steady channel run.
@@ -16,17 +16,12 @@ pub struct ChannelRun {
     pub seconds: f64,
 }
 
-/// Peak velocity of every run (lattice units): Ma = 0.017, Reynolds number at most 20.
-const U_MAX: f64 = 0.01;
-
-/// The channel of `h` fluid rows (4 columns, periodic in x) with `collision`, run until the
-/// profile changes by less than 1e-10 of u_max over 200 steps.
-pub fn poiseuille(collision: Collision, h: usize) -> Result<ChannelRun, LbmError> {
-    let nu = collision.nu();
-    let g = 8.0 * nu * U_MAX / (h * h) as f64;
+/// `nx` columns periodic in x, `h` fluid rows between resting walls at y = −½ and h − ½
+/// (halfway bounce-back).
+pub fn channel(nx: usize, h: usize) -> Domain {
     let wall = Face::Wall { velocity: [0.0; 3] };
-    let domain = Domain::new(
-        [4, h, 1],
+    Domain::new(
+        [nx, h, 1],
         [
             Face::Periodic,
             Face::Periodic,
@@ -35,8 +30,18 @@ pub fn poiseuille(collision: Collision, h: usize) -> Result<ChannelRun, LbmError
             Face::Periodic,
             Face::Periodic,
         ],
-    );
-    let mut fluid = Fluid::<D2Q9, f64>::new(domain, Vec::new());
+    )
+}
+
+/// Peak velocity of every run (lattice units): Ma = 0.017, Reynolds number at most 20.
+const U_MAX: f64 = 0.01;
+
+/// The channel of `h` fluid rows (4 columns, periodic in x) with `collision`, run until the
+/// profile changes by less than 1e-10 of u_max over 200 steps.
+pub fn poiseuille(collision: Collision, h: usize) -> Result<ChannelRun, LbmError> {
+    let nu = collision.nu();
+    let g = 8.0 * nu * U_MAX / (h * h) as f64;
+    let mut fluid = Fluid::<D2Q9, f64>::new(channel(4, h), Vec::new());
     let mut st = Stepper::new(
         &fluid,
         Settings {
