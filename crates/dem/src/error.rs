@@ -9,11 +9,14 @@ pub enum DemError {
     #[error("circle radius r = {r} must be positive and finite; fix the particle file or generator")]
     BadRadius { r: f64 },
     #[error(
-        "time step dt = {dt:e} s is above the critical time step {critical:e} s (= sqrt(m_min/k_max) \
-         with m_min = {m_min:e} kg, k_max = {k_max:e} N/m); lower dt below {critical:e} s or soften the contacts"
+        "time step dt = {dt:e} s is above the largest accepted step {limit:e} s (the lightest grain held \
+         by six grain springs and two walls; the critical time step sqrt(m_min/k_max) is {critical:e} s \
+         with m_min = {m_min:e} kg, k_max = {k_max:e} N/m; a dense packing blows up beyond it, \
+         docs/stability.md); lower dt below {limit:e} s or soften the contacts"
     )]
     TimeStepTooLarge {
         dt: f64,
+        limit: f64,
         critical: f64,
         m_min: f64,
         k_max: f64,

@@ -151,6 +151,25 @@ impl Stepper {
         (lbdem_core::units::dem::critical_time_step(m_min, k), m_min, k)
     }
 
+    /// The largest step the stepper accepts (s), [`lbdem_core::units::dem::largest_accepted_step`]:
+    /// the lightest body held by six grain springs (contacts or membrane bonds) and, if the system
+    /// has walls, pressed by two walls.
+    pub fn largest_accepted_step<L: ContactLaw, W: ContactLaw>(sys: &System, law: &L, wall_law: &W) -> f64 {
+        let b = &sys.bodies;
+        let m_min = b.mass.iter().copied().fold(f64::INFINITY, f64::min);
+        let r_max = b.circle_r.iter().copied().fold(0.0, f64::max);
+        let mut k = law.max_stiffness(0.5 * r_max);
+        if let Some(p) = &sys.bond_params {
+            k = k.max(p.k_n.max(p.k_s) * 2.0 * p.lambda * r_max);
+        }
+        lbdem_core::units::dem::largest_accepted_step(
+            m_min,
+            k,
+            wall_law.max_stiffness(r_max),
+            !sys.walls.is_empty(),
+        )
+    }
+
     /// [`Stepper::step`] compiled in this crate for the scene-selectable [`Law`]: the pair law
     /// is dispatched once per step to the pass monomorphised for it (batched kernel for the
     /// linear law), the wall law through the enum.
@@ -262,9 +281,11 @@ impl Stepper {
             if !(dt > 0.0 && dt.is_finite()) {
                 return Err(DemError::BadTimeStep { dt });
             }
-            if dt > crit && !self.past_critical {
+            let limit = Self::largest_accepted_step(sys, law, wall_law);
+            if dt > limit && !self.past_critical {
                 return Err(DemError::TimeStepTooLarge {
                     dt,
+                    limit,
                     critical: crit,
                     m_min,
                     k_max,
