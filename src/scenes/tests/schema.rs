@@ -201,3 +201,11 @@ fn the_su2020_cases_load_their_committed_assemblies() {
     // sim1, sim1-quick, sim2, sim3, 12 matrix cases, 6 Fig. 11 cases (84 %PK), float.
     assert!(built >= 23, "only {built} Su cases built their grains");
 }
+
+/// Issue 16 item 4: a TRT lattice without `magic` gets Λ = 3/16, the value the atlas's
+/// collision chart (docs/atlas.md) shows exact at the walls for the cost of 1/4.
+#[test]
+fn the_trt_magic_parameter_defaults_to_three_sixteenths() {
+    let l: crate::scenes::schema::LatticeSection = toml::from_str("dx = 1.0e-4\ntau = 0.8").unwrap();
+    assert_eq!((l.collision.as_str(), l.magic), ("trt", 0.1875));
+}
