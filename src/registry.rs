@@ -57,6 +57,7 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::mechanism_map::MechanismMap>(&["mechanism-map"], CliShape::ParamsFile),
     entry::<stages::matrix::Matrix>(&["matrix"], CliShape::ParamsFile),
     entry::<stages::tradeoffs::Tradeoffs>(&["tradeoffs"], CliShape::ParamsFile),
+    entry::<stages::minimal_models::MinimalModels>(&["minimal-models"], CliShape::ParamsFile),
 ];
 
 /// The stage kind named `kind`, or an error listing the known ones.

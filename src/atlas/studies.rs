@@ -124,17 +124,80 @@ pub fn collision(taus: &[f64], heights: &[usize]) -> Result<Vec<Point>> {
     Ok(out)
 }
 
-/// A knob swept by a finished `lbdem sweep` with replicas (e.g. sweeps/su2020-mass-scaling.toml):
-/// per value of the `axis` column, the mean wall time of a case (cases.csv) and the bound
-/// |mean paired shift| + 2 standard errors of the `result` column against the replica's case at
-/// the `reference` value (0 for the reference itself; infinite where replicas that finished at
-/// the reference failed).
-pub fn paired(study: &str, sweep: &Path, axis: &str, reference: f64, result: &str) -> Result<Vec<Point>> {
+/// The paired shifts of one value of a swept knob against the reference value, replica by
+/// replica, with the mean wall time of a case at that value.
+#[derive(Clone, Debug)]
+pub struct Shift<T> {
+    pub at: T,
+    pub shifts: Vec<f64>,
+    /// Replicas that finished at the reference but not here (blown up).
+    pub failed: usize,
+    /// Replicas that finished at the reference.
+    pub of: usize,
+    pub wall_seconds: f64,
+    /// Per replica, its wall time over the reference case's of the same replica.
+    pub wall_ratios: Vec<f64>,
+}
+
+impl<T> Shift<T> {
+    pub fn mean(&self) -> f64 {
+        self.shifts.iter().sum::<f64>() / self.shifts.len() as f64
+    }
+    /// Standard error of the mean shift (NaN below two replicas).
+    pub fn standard_error(&self) -> f64 {
+        let n = self.shifts.len() as f64;
+        if n < 2.0 {
+            return f64::NAN;
+        }
+        let m = self.mean();
+        (self.shifts.iter().map(|s| (s - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
+    }
+    /// 1 − the median of the paired wall-time ratios: the fraction of time saved, robust to a
+    /// machine whose load changes between the pairs (run them close in time: `[sweep] interleave`).
+    pub fn time_saved(&self) -> f64 {
+        let mut r = self.wall_ratios.clone();
+        if r.is_empty() {
+            return f64::NAN;
+        }
+        r.sort_by(f64::total_cmp);
+        let m = r.len() / 2;
+        let median = if r.len() % 2 == 1 {
+            r[m]
+        } else {
+            0.5 * (r[m - 1] + r[m])
+        };
+        1.0 - median
+    }
+    /// |mean| + 2 standard errors; |shift| for one realisation; infinite where replicas failed.
+    pub fn bound(&self) -> f64 {
+        if self.failed > 0 || self.shifts.is_empty() {
+            f64::INFINITY
+        } else if self.shifts.len() == 1 {
+            self.shifts[0].abs()
+        } else {
+            self.mean().abs() + 2.0 * self.standard_error()
+        }
+    }
+}
+
+/// Per value of the `axis` column of a finished sweep (values in order of first appearance),
+/// the shifts of `result` against the same replica's case at `reference`. `column` reads the
+/// axis column as `T` (numbers or names); `wall_result` names a result column to time cases by
+/// instead of their whole wall time.
+pub fn paired_shifts<T: PartialEq + Clone>(
+    study: &str,
+    sweep: &Path,
+    axis: &str,
+    reference: &T,
+    result: &str,
+    column: impl Fn(&polars::prelude::DataFrame, &str, &Path) -> Result<Vec<T>>,
+    wall_result: Option<&str>,
+) -> Result<Vec<Shift<T>>> {
     let (res_path, cases_path) = (sweep.join("results.csv"), sweep.join("cases.csv"));
     for p in [&res_path, &cases_path] {
         if !p.is_file() {
             bail!(
-                "sweep study '{study}': {} is missing; run `lbdem sweep` on the sweep file whose out is {} first (docs/atlas.md), or \
+                "sweep study '{study}': {} is missing; run `lbdem sweep` on the sweep file whose out is {} first, or \
                  leave the study out",
                 p.display(),
                 sweep.display()
@@ -143,66 +206,99 @@ pub fn paired(study: &str, sweep: &Path, axis: &str, reference: f64, result: &st
     }
     let res = read_table(&res_path)?;
     let cases = read_table(&cases_path)?;
-    let (case, knob, replica, value) = (
+    let (case, knob, value) = (
         str_column(&res, "case", &res_path)?,
-        f64_column(&res, axis, &res_path)?,
-        f64_column(&res, "replica", &res_path)?,
+        column(&res, axis, &res_path)?,
         f64_column(&res, result, &res_path)?,
     );
-    let (wall_case, wall) = (
-        str_column(&cases, "case", &cases_path)?,
-        f64_column(&cases, "wall_s", &cases_path)?,
-    );
+    // Without replicas every case is replica 0: one realisation per value.
+    let replica = match res.column("replica") {
+        Ok(_) => str_column(&res, "replica", &res_path)?,
+        Err(_) => vec![String::new(); case.len()],
+    };
+    // A case's wall time: the whole case (cases.csv), or one of its results (e.g. one stage's
+    // `wall_seconds`, leaving out stages every case shares).
+    let (wall_case, wall) = match wall_result {
+        None => (
+            str_column(&cases, "case", &cases_path)?,
+            f64_column(&cases, "wall_s", &cases_path)?,
+        ),
+        Some(w) => (case.clone(), f64_column(&res, w, &res_path)?),
+    };
     let wall_of = |c: &str| wall_case.iter().position(|w| w == c).map(|k| wall[k]);
-    let base: Vec<usize> = (0..case.len()).filter(|&k| knob[k] == reference).collect();
+    // A case that finished without the result (a packed zone never formed) counts as failed.
+    let base: Vec<usize> = (0..case.len())
+        .filter(|&k| knob[k] == *reference && value[k].is_finite())
+        .collect();
     if base.is_empty() {
         bail!(
-            "{}: no case with {axis} = {reference}, the reference of study '{study}'",
+            "{}: no finished case at the reference of study '{study}' in column {axis}",
             res_path.display()
         );
     }
-    let mut knobs = knob.clone();
-    knobs.sort_by(f64::total_cmp);
-    knobs.dedup();
-    let mut out = Vec::new();
-    for f in knobs {
-        let mut shifts = Vec::new();
-        let mut walls = Vec::new();
-        for k in (0..case.len()).filter(|&k| knob[k] == f) {
-            walls.extend(wall_of(&case[k]));
-            if let Some(&b) = base.iter().find(|&&b| replica[b] == replica[k]) {
-                shifts.push(value[k] - value[b]);
-            }
+    let mut values: Vec<T> = Vec::new();
+    for k in &knob {
+        if !values.contains(k) {
+            values.push(k.clone());
         }
-        let n = shifts.len() as f64;
-        let mean = shifts.iter().sum::<f64>() / n;
-        let se = if n > 1.0 {
-            (shifts.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
-        } else {
-            f64::NAN
-        };
-        // Replicas that finished at the reference but not here failed (a blown-up run): such a
-        // setting is not an answer, whatever its finished replicas say.
-        let failed = base.len().saturating_sub(walls.len());
-        out.push(Point {
+    }
+    Ok(values
+        .into_iter()
+        .map(|f| {
+            let mut shifts = Vec::new();
+            let mut walls = Vec::new();
+            let mut wall_ratios = Vec::new();
+            for k in (0..case.len()).filter(|&k| knob[k] == f && value[k].is_finite()) {
+                walls.extend(wall_of(&case[k]));
+                if let Some(&b) = base.iter().find(|&&b| replica[b] == replica[k]) {
+                    shifts.push(value[k] - value[b]);
+                    if let (Some(w), Some(wb)) = (wall_of(&case[k]), wall_of(&case[b])) {
+                        wall_ratios.push(w / wb);
+                    }
+                }
+            }
+            Shift {
+                wall_ratios,
+                failed: base.len().saturating_sub(walls.len()),
+                of: base.len(),
+                wall_seconds: walls.iter().sum::<f64>() / walls.len().max(1) as f64,
+                at: f,
+                shifts,
+            }
+        })
+        .collect())
+}
+
+/// A knob swept by a finished `lbdem sweep` with replicas (e.g. sweeps/su2020-mass-scaling.toml):
+/// per value of the `axis` column, the mean wall time of a case (cases.csv) and the bound
+/// |mean paired shift| + 2 standard errors of the `result` column against the replica's case at
+/// the `reference` value (0 for the reference itself; infinite where replicas that finished at
+/// the reference failed).
+pub fn paired(study: &str, sweep: &Path, axis: &str, reference: f64, result: &str) -> Result<Vec<Point>> {
+    let mut shifts = paired_shifts(study, sweep, axis, &reference, result, f64_column, None)
+        .map_err(|e| anyhow::anyhow!("{e} (reference {axis} = {reference}; docs/atlas.md)"))?;
+    shifts.sort_by(|a, b| a.at.total_cmp(&b.at));
+    Ok(shifts
+        .into_iter()
+        .map(|s| Point {
             study: study.into(),
-            setting: if failed > 0 {
-                format!("{axis} {f} ({failed} of {} failed)", base.len())
+            setting: if s.failed > 0 {
+                format!("{axis} {} ({} of {} failed)", s.at, s.failed, s.of)
             } else {
-                format!("{axis} {f}")
+                format!("{axis} {}", s.at)
             },
-            value: f,
-            error: if failed > 0 {
+            value: s.at,
+            // A setting with failed replicas is not an answer, whatever its finished ones say.
+            error: if s.failed > 0 {
                 f64::INFINITY
-            } else if f == reference {
+            } else if s.at == reference {
                 0.0
             } else {
-                mean.abs() + 2.0 * se
+                s.mean().abs() + 2.0 * s.standard_error()
             },
-            wall_seconds: walls.iter().sum::<f64>() / walls.len().max(1) as f64,
-        });
-    }
-    Ok(out)
+            wall_seconds: s.wall_seconds,
+        })
+        .collect())
 }
 
 #[cfg(test)]

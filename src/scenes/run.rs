@@ -135,6 +135,9 @@ pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResul
         .num_threads(threads)
         .build()
         .context("cannot start the thread pool")?;
+    if !l.simplified.is_empty() && !crate::contract::quiet() {
+        eprintln!("{}: simplified: {}", l.name, l.simplified.join("; "));
+    }
     pool.install(|| {
         let mut m = model(l, resume)?;
         let total = total_steps(s, m.dt());
@@ -156,7 +159,7 @@ pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResul
             "scene": l.name, "physics": l.physics, "steps": ending.steps, "time": ending.time,
             "stopped": ending.stopped, "wall_seconds": ending.wall_s, "resumed_from": ending.resumed_from,
             "steps_per_second": ending.steps as f64 / ending.wall_s.max(1e-12),
-            "engine": m.describe(),
+            "engine": m.describe(), "simplified": l.simplified,
         });
         for o in &obs {
             let (f, entry) = o.report(m.as_ref());

@@ -73,5 +73,6 @@ mod float;
 mod fluid;
 mod initial;
 mod initial_fluid;
+mod minimal;
 mod schema;
 mod shear_cell;

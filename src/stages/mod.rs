@@ -9,6 +9,7 @@ pub mod compare;
 pub mod digitise;
 pub mod matrix;
 pub mod mechanism_map;
+pub mod minimal_models;
 pub mod radiograph;
 pub mod report;
 pub mod run_data;

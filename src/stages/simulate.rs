@@ -37,6 +37,7 @@ impl Stage for Simulate {
         if let Ok(l) = crate::scenes::schema::load(&scene, &p.overrides) {
             // ...and the files it extends.
             v.extend(l.sources.iter().skip(1).cloned());
+            v.extend(l.minimal_table.clone());
             let pc = l.scene.particles.as_ref();
             if let Some(csv) = pc.and_then(|pc| pc.continue_from.as_ref().or(pc.csv.as_ref())) {
                 let p = l.base_dir.join(csv);

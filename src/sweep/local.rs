@@ -124,19 +124,24 @@ pub fn run_case(case: &Case, o: &CaseOpts) -> Outcome {
 /// The cases still to hand out, shared by every worker (and by MPI's dispatcher).
 pub struct Queue {
     next: AtomicUsize,
-    len: usize,
+    order: Vec<usize>,
 }
 
 impl Queue {
-    pub fn new(len: usize) -> Self {
+    /// The cases in their order, or replica by replica with `interleave` (`[sweep] interleave`).
+    pub fn new(cases: &[Case], interleave: bool) -> Self {
+        let mut order: Vec<usize> = (0..cases.len()).collect();
+        if interleave {
+            order.sort_by_key(|&i| (cases[i].replica.map_or(0, |r| r.0), i));
+        }
         Self {
             next: AtomicUsize::new(0),
-            len,
+            order,
         }
     }
     pub fn take(&self) -> Option<usize> {
         let i = self.next.fetch_add(1, Ordering::Relaxed);
-        (i < self.len).then_some(i)
+        self.order.get(i).copied()
     }
 }
 
@@ -166,12 +171,13 @@ pub fn run_workers(
 /// Every case on this machine; outcomes in case order.
 pub fn run_all(
     cases: &[Case],
+    interleave: bool,
     parallel: usize,
     o: &CaseOpts,
     progress: &super::progress::SweepProgress,
 ) -> Vec<Outcome> {
     let slots: Mutex<Vec<Option<Outcome>>> = Mutex::new(vec![None; cases.len()]);
-    let queue = Queue::new(cases.len());
+    let queue = Queue::new(cases, interleave);
     run_workers(
         cases,
         &queue,

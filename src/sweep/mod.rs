@@ -116,7 +116,7 @@ pub fn run(args: &Args) -> Result<Summary> {
         threads,
         force: args.force,
     };
-    let outcomes = local::run_all(&cases, parallel, &opts, &progress);
+    let outcomes = local::run_all(&cases, sweep.interleave, parallel, &opts, &progress);
     progress.finish();
     finish(
         &sweep,

@@ -85,7 +85,7 @@ pub fn run(
         out.display()
     );
     let progress = SweepProgress::new(cases.len(), size as usize, false);
-    let queue = Queue::new(cases.len());
+    let queue = Queue::new(cases, sweep.interleave);
     let slots: Mutex<Vec<Option<Outcome>>> = Mutex::new(vec![None; cases.len()]);
     let record = |i: usize, o: Outcome| {
         progress.finished(&cases[i], &o);

@@ -62,6 +62,8 @@ struct Header {
     parallel: usize,
     #[serde(default)]
     threads: usize,
+    #[serde(default)]
+    interleave: bool,
 }
 
 /// What every case runs: a scene file (as `lbdem simulate`) or a pipeline file (as `lbdem run`).
@@ -180,6 +182,9 @@ pub struct Sweep {
     pub out: PathBuf,
     pub parallel: usize,
     pub threads: usize,
+    /// Run replica by replica (every point of the first replica, then of the second ...) so that
+    /// paired cases run close in time and their wall-time ratio is fair on a shared machine.
+    pub interleave: bool,
     pub set: Vec<(String, toml::Value)>,
     pub axes: Vec<Axis>,
     pub replicas: Option<Replicas>,
@@ -291,6 +296,7 @@ impl Sweep {
             out,
             parallel: f.sweep.parallel,
             threads: f.sweep.threads,
+            interleave: f.sweep.interleave,
             set,
             axes: f.axis,
             replicas: f.replicas,

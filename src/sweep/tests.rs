@@ -261,6 +261,16 @@ first = 10
         11
     );
     assert_eq!(l.scene.run.steps, Some(100));
+    // Run order: as expanded, or replica by replica with [sweep] interleave.
+    let order = |q: local::Queue| std::iter::from_fn(|| q.take()).collect::<Vec<_>>();
+    assert_eq!(
+        order(local::Queue::new(&cases, false)),
+        (0..12).collect::<Vec<_>>()
+    );
+    assert_eq!(
+        order(local::Queue::new(&cases, true)),
+        [0, 2, 4, 6, 8, 10, 1, 3, 5, 7, 9, 11]
+    );
 }
 
 #[test]

@@ -16,6 +16,7 @@ mod legacy;
 mod packed_zone;
 mod run;
 mod shear_cell;
+pub mod simplify;
 
 pub use coupling::CouplingSection;
 pub use dem::{
@@ -48,6 +49,16 @@ pub struct Header {
     /// few values (Su et al. 2020's 4 × 3 matrix).
     #[serde(default)]
     pub extends: Option<PathBuf>,
+    /// Physics to switch off or simplify, by name (`"no-rolling+f32"` or a list; "none"):
+    /// [`simplify::CATALOGUE`], docs/minimal.md.
+    #[serde(default)]
+    pub simplify: Option<toml::Value>,
+    /// Apply every simplification the scene family's minimal-model table shows harmless.
+    #[serde(default)]
+    pub minimal: bool,
+    /// That table, relative to this file (default `minimal.csv` beside it).
+    #[serde(default)]
+    pub minimal_table: Option<PathBuf>,
 }
 
 /// `[domain]`: the box (m), 2 or 3 entries per key, and which axes are periodic (for the grains
@@ -153,6 +164,10 @@ pub struct Loaded {
     pub path: PathBuf,
     /// The files the scene was read from: itself, then what it extends.
     pub sources: Vec<PathBuf>,
+    /// The simplifications applied (`[scene] simplify` and `minimal`), each with why.
+    pub simplified: Vec<String>,
+    /// The minimal-model table `minimal = true` read.
+    pub minimal_table: Option<PathBuf>,
 }
 
 /// How many `extends` a scene may chain.
@@ -207,10 +222,15 @@ pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
     let mut sources = Vec::new();
     let (mut value, text) = read_table(path, &mut sources)?;
     merge(&mut value, overrides);
+    let simplify::Applied {
+        names: simplified,
+        table: minimal_table,
+    } = simplify::apply(&mut value, path)?;
     let own = std::fs::read_to_string(path).unwrap_or_default();
     check::values(&value, path, &own, overrides)?;
-    // Parse from text so that errors point at the line (overrides are re-serialised).
-    let text = if overrides.is_empty() {
+    // Parse from text so that errors point at the line (overrides and simplifications are
+    // re-serialised).
+    let text = if overrides.is_empty() && simplified.is_empty() {
         text
     } else {
         toml::to_string(&value)?
@@ -230,6 +250,8 @@ pub fn load(path: &Path, overrides: &toml::Table) -> Result<Loaded> {
         base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         path: path.to_path_buf(),
         sources,
+        simplified,
+        minimal_table,
         scene,
     })
 }
