@@ -196,6 +196,8 @@ impl<T: Real> CoupledModel<T> {
             .num_threads(threads)
             .build()
             .context("cannot start the thread pool")?;
+        // A resumed run takes the plate, the origin and the wall starts from its checkpoint.
+        shear_cell::clear_plate_noting(s, &mut run.sys)?;
         let cell = Tracked::start(s, &run.sys)?;
         if let (Some(c), Some(sc)) = (&cell, &s.shear_cell)
             && sc.confine_liquid

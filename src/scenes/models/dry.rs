@@ -68,6 +68,9 @@ impl Dry {
             sys.time = 0.0;
             stepper = Stepper::new();
         }
+        if prepare {
+            shear_cell::clear_plate_noting(s, &mut sys)?;
+        }
         let wall_start = sys.walls.iter().map(wall_anchor).collect();
         let cell = Tracked::start(s, &sys)?;
         Ok(Self {

@@ -46,6 +46,55 @@ fn anchor(sys: &System, k: usize) -> Vec2 {
     }
 }
 
+/// Move the push-plate back along its motion until no grain circle overlaps it, before the
+/// first step; the distance moved (m), 0 when nothing overlapped, None without `[shear_cell]`.
+///
+/// An assembly built inside servo walls leaves its bottom row a few µm into where the plate is
+/// drawn (the 84 %PK assembly: 4.5 µm); with the paper's grain-wall stiffness (31.1 N/m) and
+/// grains of 6e-9 kg that overlap is released at about 0.2 m/s in the first steps, which blew up
+/// the unscaled pk84-2150um scene's lattice at LBM step 217 (docs/minimal.md). A fresh run only:
+/// a resumed one takes the plate from its checkpoint.
+pub fn clear_plate(s: &Scene, sys: &mut System) -> Result<Option<f64>> {
+    let Some(sc) = &s.shear_cell else {
+        return Ok(None);
+    };
+    let k = wall_index(s, &sc.plate).map_err(|e| anyhow::anyhow!("[shear_cell] plate: {e}"))?;
+    let dir = match sys.walls[k].motion {
+        WallMotion::Velocity { v } if v.norm() > 0.0 => v * (1.0 / v.norm()),
+        // ShearCell::new refuses it with the reason.
+        _ => return Ok(Some(0.0)),
+    };
+    let mut moved = 0.0;
+    // A segment tilted against its motion needs more than one pass; three settle any plate.
+    for _ in 0..3 {
+        let b = &sys.bodies;
+        let deepest = (0..b.n_circles())
+            .filter_map(|c| sys.walls[k].touch_within(b.circle_pos(c), b.circle_r[c], 0.0))
+            .map(|(overlap, _)| overlap)
+            .fold(0.0f64, f64::max);
+        if deepest <= 0.0 {
+            break;
+        }
+        sys.walls[k].translate(dir * -deepest);
+        moved += deepest;
+    }
+    Ok(Some(moved))
+}
+
+/// [`clear_plate`], saying how far the plate moved when it did.
+pub fn clear_plate_noting(s: &Scene, sys: &mut System) -> Result<()> {
+    if let Some(d) = clear_plate(s, sys)?.filter(|d| *d > 0.0)
+        && !crate::contract::quiet()
+    {
+        eprintln!(
+            "[shear_cell]: the push-plate overlapped the grains by up to {:.2} um at the start; moved it back \
+             as far along its motion, so the first step kicks no grain",
+            d * 1e6
+        );
+    }
+    Ok(())
+}
+
 impl ShearCell {
     /// The cell of `s` (None without `[shear_cell]`), checked against the built system.
     pub fn new(s: &Scene, sys: &System) -> Result<Option<Self>> {

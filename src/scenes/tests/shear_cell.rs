@@ -414,3 +414,39 @@ fn keeping_the_solid_map_within_a_twentieth_of_a_cell_leaves_the_results_unchang
     // are twice these; a change of the code that moves the chaos may need them measured again.
     assert_within(a, &b, 0.011, 0.011, 0.006);
 }
+
+/// A push-plate drawn into the bottom row (as an assembly built inside servo walls leaves it:
+/// the 84 %PK assembly by 4.5 µm) is moved back along its motion until it just touches the
+/// grains, so the first step kicks none (docs/minimal.md: the unscaled pk84-2150um scene blew
+/// up at LBM step 217 from that kick).
+#[test]
+fn a_plate_drawn_into_the_grains_starts_just_touching_them() {
+    let t = tempfile::tempdir().unwrap();
+    let text = cell(t.path(), |s| {
+        dry(s).replace(
+            "a = [0.003, 0.00102]\nb = [0.005, 0.00102]",
+            "a = [0.003, 0.0011]\nb = [0.005, 0.0011]",
+        )
+    });
+    assert!(text.contains("a = [0.003, 0.0011]"));
+    let path = t.path().join("scene/scene.toml");
+    std::fs::write(&path, text).unwrap();
+    let l = crate::scenes::schema::load(&path, &Default::default()).unwrap();
+    let built = crate::scenes::models::dry::Dry::build(&l.scene, &l.base_dir, true).unwrap();
+    let (sys, k) = (&built.sys, 0);
+    let b = &sys.bodies;
+    let overlaps: Vec<f64> = (0..b.n_circles())
+        .filter_map(|c| sys.walls[k].touch_within(b.circle_pos(c), b.circle_r[c], 1e-12))
+        .map(|(o, _)| o)
+        .collect();
+    // Touching (within 1e-12 m), overlapping nothing.
+    assert!(
+        !overlaps.is_empty() && overlaps.iter().all(|o| *o <= 1e-12),
+        "{overlaps:?}"
+    );
+    let y = match sys.walls[k].shape {
+        lbdem_dem::WallShape::Segment { a, .. } => a.y,
+        _ => unreachable!(),
+    };
+    assert!(y < 0.0011 - 1e-6, "the plate did not move: {y}");
+}
