@@ -90,7 +90,8 @@ pub fn coupling(resolutions: &[usize], duration: f64) -> Result<(Vec<Point>, Vec
 
 /// BGK against TRT: plane Poiseuille flow between halfway bounce-back walls ([`poiseuille`]),
 /// the largest deviation from the parabola over u_max, at each τ and channel height. TRT at the
-/// scenes' default Λ = 1/4 slips as BGK at τ = 1 at every τ; at Λ = 3/16 it does not slip.
+/// former default Λ = 1/4 slips as BGK at τ = 1 at every τ; at Λ = 3/16 (the default now) it
+/// does not slip.
 pub fn collision(taus: &[f64], heights: &[usize]) -> Result<Vec<Point>> {
     let mut out = Vec::new();
     for &tau in taus {
