@@ -40,6 +40,24 @@ pub fn pareto_png(path: &Path, points: &[Point], front: &[bool], axes: &Axes) ->
         .collect();
     on_front.sort_by(|a, b| a.wall_seconds.total_cmp(&b.wall_seconds));
     let (fx, fy): (Vec<f64>, Vec<f64>) = on_front.iter().map(|p| (p.wall_seconds, floor(p.error))).unzip();
+    xy_png(
+        path,
+        &markers_and_line(&data, ("non-dominated", &fx, &fy)),
+        &XyPlot {
+            title: axes.title,
+            x_label: "wall time per run (s)",
+            y_label: axes.error_label,
+            log_x: axes.log,
+            log_y: axes.log,
+        },
+    )
+}
+
+/// One marker series per labelled (x, y) set, then one line (a front, a tolerance).
+pub fn markers_and_line<'a>(
+    data: &'a [(String, Vec<f64>, Vec<f64>)],
+    line: (&'a str, &'a [f64], &'a [f64]),
+) -> Vec<Series<'a>> {
     let mut series: Vec<Series> = data
         .iter()
         .map(|(l, x, y)| Series {
@@ -50,20 +68,10 @@ pub fn pareto_png(path: &Path, points: &[Point], front: &[bool], axes: &Axes) ->
         })
         .collect();
     series.push(Series {
-        label: "non-dominated",
-        x: &fx,
-        y: &fy,
+        label: line.0,
+        x: line.1,
+        y: line.2,
         points: false,
     });
-    xy_png(
-        path,
-        &series,
-        &XyPlot {
-            title: axes.title,
-            x_label: "wall time per run (s)",
-            y_label: axes.error_label,
-            log_x: axes.log,
-            log_y: axes.log,
-        },
-    )
+    series
 }

@@ -125,6 +125,14 @@ pub fn collision(taus: &[f64], heights: &[usize]) -> Result<Vec<Point>> {
     Ok(out)
 }
 
+/// The tables a study reads from each finished sweep directory (the inputs of a stage that
+/// reads sweeps: a rerun sweep changes its key).
+pub fn sweep_tables(dirs: impl Iterator<Item = std::path::PathBuf>) -> Vec<std::path::PathBuf> {
+    dirs.flat_map(|d| [d.join("results.csv"), d.join("cases.csv")])
+        .filter(|f| f.is_file())
+        .collect()
+}
+
 /// The paired shifts of one value of a swept knob against the reference value, replica by
 /// replica, with the mean wall time of a case at that value.
 #[derive(Clone, Debug)]

@@ -4,9 +4,10 @@
 //! wall time, with the verdict harmless or not against the tolerance stated for that result.
 //! `[scene] minimal = true` applies what this table shows harmless (src/scenes/schema/simplify.rs).
 
-use crate::atlas::studies::{Shift, paired_shifts};
+use crate::atlas::chart::markers_and_line;
+use crate::atlas::studies::{Shift, paired_shifts, sweep_tables};
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
-use crate::report::plot::{Series, XyPlot, xy_png};
+use crate::report::plot::{XyPlot, xy_png};
 use crate::report::table::{Col, str_column, write_table};
 use crate::scenes::schema::simplify;
 use anyhow::{Context, Result, bail};
@@ -84,12 +85,7 @@ impl Stage for MinimalModels {
     type Params = Params;
 
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
-        p.studies
-            .iter()
-            .map(|s| ctx.resolve(&s.sweep))
-            .flat_map(|d| [d.join("results.csv"), d.join("cases.csv")])
-            .filter(|f| f.is_file())
-            .collect()
+        sweep_tables(p.studies.iter().map(|s| ctx.resolve(&s.sweep)))
     }
 
     fn run(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
@@ -256,38 +252,22 @@ fn chart(path: &std::path::Path, s: &Study, rows: &[Row]) -> Result<()> {
         .iter()
         .filter(|r| std::ptr::eq(r.study, s) && r.shift.bound().is_finite())
         .collect();
-    let pts: Vec<(String, [f64; 1], [f64; 1])> = mine
+    let data: Vec<(String, Vec<f64>, Vec<f64>)> = mine
         .iter()
         .map(|r| {
             (
                 r.shift.at.clone(),
-                [100.0 * r.time_saved()],
-                [r.shift.bound() / s.tolerance],
+                vec![100.0 * r.time_saved()],
+                vec![r.shift.bound() / s.tolerance],
             )
         })
         .collect();
-    let xs: Vec<f64> = pts.iter().map(|p| p.1[0]).collect();
-    let lo = xs.iter().copied().fold(0.0f64, f64::min);
-    let hi = xs.iter().copied().fold(1.0f64, f64::max);
+    let lo = data.iter().map(|p| p.1[0]).fold(0.0f64, f64::min);
+    let hi = data.iter().map(|p| p.1[0]).fold(1.0f64, f64::max);
     let (lx, ly) = ([lo, hi], [1.0, 1.0]);
-    let mut series: Vec<Series> = pts
-        .iter()
-        .map(|(l, x, y)| Series {
-            label: l,
-            x,
-            y,
-            points: true,
-        })
-        .collect();
-    series.push(Series {
-        label: "tolerance",
-        x: &lx,
-        y: &ly,
-        points: false,
-    });
     xy_png(
         path,
-        &series,
+        &markers_and_line(&data, ("tolerance", &lx, &ly)),
         &XyPlot {
             title: &format!("{}: what each simplification changes and saves", s.study),
             x_label: "wall time saved (%)",

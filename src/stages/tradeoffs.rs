@@ -99,12 +99,7 @@ impl Stage for Tradeoffs {
     type Params = Params;
 
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
-        p.sweeps
-            .iter()
-            .map(|s| ctx.resolve(&s.dir))
-            .flat_map(|d| [d.join("results.csv"), d.join("cases.csv")])
-            .filter(|f| f.is_file())
-            .collect()
+        studies::sweep_tables(p.sweeps.iter().map(|s| ctx.resolve(&s.dir)))
     }
 
     fn run(p: &Params, ctx: &StageContext) -> Result<StageOutput> {

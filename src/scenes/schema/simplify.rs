@@ -79,6 +79,14 @@ fn section<'a>(t: &'a mut toml::Table, name: &str) -> Option<&'a mut toml::Table
     t.get_mut(name).and_then(Value::as_table_mut)
 }
 
+/// `[coupling]`, made empty if the scene has none.
+fn coupling(t: &mut toml::Table) -> Result<&mut toml::Table, String> {
+    t.entry("coupling")
+        .or_insert_with(|| Value::Table(toml::Table::new()))
+        .as_table_mut()
+        .ok_or_else(|| "[coupling] is not a table".into())
+}
+
 /// Grains in a liquid that is on (`no-liquid` applied first leaves nothing for the liquid's
 /// simplifications to do).
 fn coupled(t: &toml::Table) -> bool {
@@ -101,10 +109,7 @@ fn need_liquid(t: &toml::Table) -> Result<(), String> {
 
 fn no_liquid(t: &mut toml::Table) -> Result<(), String> {
     need_liquid(t)?;
-    let c = t
-        .entry("coupling")
-        .or_insert_with(|| Value::Table(toml::Table::new()));
-    let c = c.as_table_mut().ok_or("[coupling] is not a table")?;
+    let c = coupling(t)?;
     c.insert("liquid".into(), Value::Boolean(false));
     Ok(())
 }
@@ -150,10 +155,7 @@ fn dry_membrane(t: &mut toml::Table) -> Result<(), String> {
     if !t.contains_key("membrane") {
         return Err("the scene has no [membrane]".into());
     }
-    let c = t
-        .entry("coupling")
-        .or_insert_with(|| Value::Table(toml::Table::new()));
-    let c = c.as_table_mut().ok_or("[coupling] is not a table")?;
+    let c = coupling(t)?;
     c.insert("dry_membrane".into(), Value::Boolean(true));
     Ok(())
 }
@@ -172,10 +174,7 @@ fn f32_populations(t: &mut toml::Table) -> Result<(), String> {
 
 fn remap(t: &mut toml::Table) -> Result<(), String> {
     need_liquid(t)?;
-    let c = t
-        .entry("coupling")
-        .or_insert_with(|| Value::Table(toml::Table::new()));
-    let c = c.as_table_mut().ok_or("[coupling] is not a table")?;
+    let c = coupling(t)?;
     if c.get("method").and_then(Value::as_str) == Some("bounce-back") {
         return Err("remap_tolerance is for PSM; [coupling] method is bounce-back".into());
     }
