@@ -104,9 +104,11 @@ fn su2020_ci_pipeline_analyses_compares_maps_and_reports() {
     assert!(out.join("analyse-float/packed_zone.png").is_file());
 
     // The run rendered as radiographs and put through the radiograph stage: XIP beside TRI on the
-    // same snapshots. Measured at u_y = 0.95 d: XIP 0.0124, Eq. 5 on the true solid fraction
-    // 0.0145, the triangulation's own Eq. 5 (area ratio per REV) 0.0156, ε_vol^DEM 0.0157;
-    // (6.6e-5 apart); RMS per pixel XIP - truth 0.0060; correlation of XIP with ε_xx + ε_yy 0.72.
+    // same snapshots. Measured at u_y = 0.95 d (since the resting solid zone, 2026-11-25): XIP
+    // 0.0112, Eq. 5 on the true solid fraction 0.0127, the triangulation's own Eq. 5 (area
+    // ratio per REV) 0.0139, ε_vol^DEM 0.0148 (8.5e-4 apart: the REVs average the ratio over
+    // the grains' interior, ε_vol^DEM is the membrane's area); RMS per pixel XIP - truth 0.0058;
+    // correlation of XIP with ε_xx + ε_yy 0.76.
     let cmp = json(&out.join("compare/comparison.json"));
     let l = &cmp["last"];
     let f = |k: &str| l[k].as_f64().unwrap_or_else(|| panic!("{k} in {l}"));
@@ -119,7 +121,7 @@ fn su2020_ci_pipeline_analyses_compares_maps_and_reports() {
         "{l}"
     );
     assert!(
-        (f("mean_area_strain_tri") - f("eps_vol_dem")).abs() < 1.4e-4,
+        (f("mean_area_strain_tri") - f("eps_vol_dem")).abs() < 1.7e-3,
         "{l}"
     );
     assert!(f("rms_xip_minus_true_eq5") < 0.012, "{l}");
