@@ -14,7 +14,7 @@ use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::{FluidFields, write_fluid, write_particles};
 use crate::scenes::timeloop::{Model, Probe};
 use anyhow::{Context, Result, bail};
-use lbdem_core::units::coupled::{LOAD_DENSITY_MAX, buoyant_load};
+use lbdem_core::units::coupled::{LOAD_DENSITY_MAX, PSM_DENSITY_RATIO_MIN, buoyant_load};
 use lbdem_coupling::bounce::BounceFluid;
 use lbdem_coupling::units::CouplingUnits;
 use lbdem_coupling::{Coupled, Hydro, Method, PsmFluid, PsmSettings};
@@ -172,6 +172,9 @@ impl<T: Real> CoupledModel<T> {
             for k in 0..run.sys.bodies.len() {
                 run.dry[k] = run.sys.bodies.tag[k] == 1;
             }
+        }
+        if cs.method == Method::Psm {
+            light_grains(&run, s.fluid.as_ref().map_or(0.0, |f| f.density))?;
         }
         if cs.interior_liquid_correction {
             run = run
@@ -457,6 +460,27 @@ impl<T: Real> Model for CoupledModel<T> {
         }
         Ok(())
     }
+}
+
+/// Refuse a PSM scene whose lightest wet grain is under [`PSM_DENSITY_RATIO_MIN`] times the
+/// liquid's density (its inertia, mass scaling included): the explicit coupling blows up there
+/// (docs/stability.md, "Near-neutral grains").
+fn light_grains<T: Real>(run: &Coupled<T>, fluid_density: f64) -> Result<()> {
+    let b = &run.sys.bodies;
+    let lightest = (0..b.len())
+        .filter(|&k| !run.dry[k])
+        .map(|k| b.density[k] / run.depth)
+        .fold(f64::INFINITY, f64::min);
+    let ratio = lightest / fluid_density;
+    if ratio < PSM_DENSITY_RATIO_MIN {
+        bail!(
+            "[particles] density with [dem] mass_scale: the lightest grain that feels the liquid is {lightest:.4} \
+             kg/m³ over [coupling] depth, {ratio:.3} times [fluid] density {fluid_density} kg/m³; below \
+             {PSM_DENSITY_RATIO_MIN} the explicit PSM coupling blows up (the reduced shear cell did at 0.45, \
+             docs/stability.md). Raise [dem] mass_scale (a quasi-static run allows it) or the grains' density"
+        );
+    }
+    Ok(())
 }
 
 /// Refuse a scene whose grains' buoyant weight the lattice cannot carry: the pressure difference

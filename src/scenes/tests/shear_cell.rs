@@ -483,3 +483,32 @@ fn an_undriven_sample_at_the_papers_densities_settles_in_its_confined_liquid() {
         ke[29]
     );
 }
+
+/// The near-neutral-grain check agrees with the density-ratio map (docs/stability.md): the
+/// reduced cell with grains 0.45 times the liquid's density (mass scale 0.5; every such run
+/// blew up) is refused before it starts and leaves nothing behind, at 0.56 (every such run
+/// finished) it runs.
+#[test]
+fn grains_lighter_than_half_the_liquid_are_refused_as_the_density_map_found() {
+    for (scale, refused) in [(0.5, true), (0.625, false)] {
+        let t = tempfile::tempdir().unwrap();
+        let text = cell(t.path(), |s| {
+            shorter("0.001")(s).replace("[dem]\n", &format!("[dem]\nmass_scale = {scale}\n"))
+        });
+        assert!(text.contains(&format!("mass_scale = {scale}")));
+        let got = simulate(&text, t.path(), false);
+        if refused {
+            let e = format!("{:#}", got.unwrap_err());
+            assert!(
+                e.contains("0.451 times [fluid] density") && e.contains("mass_scale"),
+                "{e}"
+            );
+            assert!(
+                !t.path().join("out").exists(),
+                "the refused run left output behind"
+            );
+        } else {
+            got.unwrap();
+        }
+    }
+}

@@ -82,6 +82,14 @@ impl CouplingUnits {
 /// (`scenes/su2020/float.toml`, docs/stability.md "The liquid's pressure load").
 pub const LOAD_DENSITY_MAX: f64 = 0.5;
 
+/// Smallest grain-to-liquid density ratio (with any mass scaling: the grains' inertia) a PSM
+/// scene may have among the grains that feel the liquid. The coupling is explicit: the load of
+/// one LBM step is held over the DEM sub-steps, and a grain lighter than the liquid its solid
+/// term moves overshoots. Found by running the reduced Su shear cell from 0.23 to 3.6
+/// (`sweeps/su2020-density-ratio.toml`, docs/stability.md "Near-neutral grains"): every run at
+/// 0.45 and below blew up, every run at 0.56 and above finished. Su's cases sit at 0.90-0.96.
+pub const PSM_DENSITY_RATIO_MIN: f64 = 0.5;
+
 /// The pressure difference (Pa) the liquid must carry when the grains move through it as one
 /// packing: their buoyant weight over the box's width, Δp = Σ m_i |a| / (W d), with `mass` the
 /// grains' total mass (kg, over the sample depth `depth`, m), `accel` the net acceleration the DEM
