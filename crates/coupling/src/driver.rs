@@ -212,12 +212,8 @@ impl<T: Real> Coupled<T> {
                     .into(),
             ));
         }
-        let b = &self.sys.bodies;
         let rho_f = self.units.lattice.rho;
-        let lightest = (0..b.len())
-            .filter(|&k| !self.dry[k])
-            .map(|k| b.density[k] / self.depth)
-            .fold(f64::INFINITY, f64::min);
+        let lightest = self.lightest_wet_density();
         let ratio = lightest / rho_f;
         if ratio.is_nan() || ratio < 1.2 {
             return Err(CouplingError::Unsupported(format!(
@@ -228,6 +224,21 @@ impl<T: Real> Coupled<T> {
         }
         self.interior_liquid_correction = true;
         Ok(self)
+    }
+
+    /// Density (kg/m³: the per-area density over the depth, mass scaling included) of the lightest
+    /// grain that feels the liquid; infinite if none does.
+    pub fn lightest_wet_density(&self) -> f64 {
+        let b = &self.sys.bodies;
+        (0..b.len())
+            .filter(|&k| !self.dry[k])
+            .map(|k| b.density[k] / self.depth)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The lattice's liquid density (kg/m³).
+    pub fn liquid_density(&self) -> f64 {
+        self.units.lattice.rho
     }
 
     /// One LBM cycle and `ratio` DEM cycles.

@@ -130,8 +130,9 @@ fn the_plate_compacts_the_grains_ahead_and_the_liquid_stays_inside_the_membrane(
         "{outside} of {liquid} liquid nodes outside"
     );
     // The resting solid zone takes the liquid of the nodes it closes and refills the nodes it
-    // opens: the liquid's mass follows the sample's area, and this sample dilates
-    // (ε_vol^DEM = +1.5 %). Measured: drift +0.0230 at the end, largest 0.0230.
+    // opens: the liquid's mass grows with the sample's area, by more than it here (this sample
+    // dilates, ε_vol^DEM = +1.5 %; the mass grows 2.3 %, not explained yet). Measured: drift
+    // +0.0230 at the end, largest 0.0230.
     let drift = column(&out, "liquid_mass_drift");
     let worst = drift.iter().fold(0.0f64, |a, d| a.max(d.abs()));
     assert!(worst < 0.046, "liquid mass drifted by {worst}");
@@ -142,8 +143,9 @@ fn the_plate_compacts_the_grains_ahead_and_the_liquid_stays_inside_the_membrane(
         "a dilating sample draws liquid in: ε_vol^DEM {eps}, drift {last}"
     );
 
-    // The liquid's pressure falls most just above the plate (Su et al. 2020 Sect. 4: the first
-    // critical pressure drop is "adjacent to or above the top-right corner of the push-plate"):
+    // The liquid's pressure falls most just above the plate (within its width, 1.5 mm above
+    // it; Su et al. 2020 Sect. 4 place the first critical drop "adjacent to or above the
+    // top-right corner of the push-plate", a finer statement this window does not test):
     // the resting solid zone under the rising membrane takes liquid the grains above draw
     // after them. Measured at the end: lowest Δp −6.4 Pa at x 4.15 mm (the plate spans 3-5
     // mm), 0.48 mm above the plate.
@@ -476,7 +478,9 @@ fn an_undriven_sample_at_the_papers_densities_settles_in_its_confined_liquid() {
     let ke = column(&t.path().join("out"), "kinetic_energy");
     assert_eq!(ke.len(), 30);
     let peak = ke.iter().cloned().fold(0.0, f64::max);
-    // Measured: peak 8.67e-13 J at step 15, 6.51e-13 J (0.75 of it) at step 30.
+    // Measured: 7.25e-14 J at step 1, peak 8.67e-13 J at step 15, 6.51e-13 J (0.75 of it) at
+    // step 30.
+    assert!(peak > 5.0 * ke[0], "the grains never picked up speed: {ke:?}");
     assert!(
         ke[29] < 0.85 * peak,
         "kinetic energy {:.3e} J at step 30, peak {peak:.3e} J: the grains do not settle",
@@ -500,7 +504,7 @@ fn grains_lighter_than_half_the_liquid_are_refused_as_the_density_map_found() {
         if refused {
             let e = format!("{:#}", got.unwrap_err());
             assert!(
-                e.contains("0.451 times [fluid] density") && e.contains("mass_scale"),
+                e.contains("0.451 times the liquid's") && e.contains("mass_scale to at least"),
                 "{e}"
             );
             assert!(

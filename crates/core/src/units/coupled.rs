@@ -87,7 +87,7 @@ pub const LOAD_DENSITY_MAX: f64 = 0.5;
 /// one LBM step is held over the DEM sub-steps, and a grain lighter than the liquid its solid
 /// term moves overshoots. Found by running the reduced Su shear cell from 0.23 to 3.6
 /// (`sweeps/su2020-density-ratio.toml`, docs/stability.md "Near-neutral grains"): every run at
-/// 0.45 and below blew up, every run at 0.56 and above finished. Su's cases sit at 0.90-0.96.
+/// 0.45 and below blew up, every run at 0.56 and above finished. Su's cases sit at 0.90-0.97.
 pub const PSM_DENSITY_RATIO_MIN: f64 = 0.5;
 
 /// The pressure difference (Pa) the liquid must carry when the grains move through it as one
