@@ -158,6 +158,8 @@ fn stage_command(name: &'static str, kind: &'static StageKind) -> Command {
 
 pub fn main() -> Result<()> {
     let m = command().get_matches();
+    // A typo in LBDEM_ISA is refused before anything runs (the kernels would ignore it).
+    lbdem_core::simd::requested()?;
     match m.subcommand() {
         Some(("run", a)) => {
             let path = a.get_one::<PathBuf>("pipeline").context("PIPELINE is required")?;

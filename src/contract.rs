@@ -241,6 +241,10 @@ pub struct Provenance {
     /// Seconds since the Unix epoch when the run started.
     pub started_unix_s: u64,
     pub threads: usize,
+    /// The instruction-set level the kernels ran with (`lbdem_core::simd`): wall times depend
+    /// on it, results do not.
+    #[serde(default)]
+    pub simd: String,
     pub stages: Vec<StageProvenance>,
     pub total_wall_s: f64,
 }

@@ -16,6 +16,7 @@ pub fn start(path: &Path, pipeline: &Pipeline) -> Result<Provenance> {
         pipeline_file: hash_file(path)?,
         started_unix_s: started,
         threads: rayon::current_num_threads(),
+        simd: lbdem_core::simd::level().name().to_string(),
         stages: Vec::new(),
         total_wall_s: 0.0,
     })

@@ -102,6 +102,7 @@ fn standalone_provenance(stages: &[(String, PathBuf)]) -> Provenance {
         },
         started_unix_s: 0,
         threads: rayon::current_num_threads(),
+        simd: lbdem_core::simd::level().name().to_string(),
         stages: stages
             .iter()
             .filter_map(|(_, d)| {

@@ -307,6 +307,7 @@ fn provenance(sweep: &Sweep, file: &InputHash, cases: &[Case], wall_s: f64, thre
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.as_secs().saturating_sub(wall_s as u64)),
         threads,
+        simd: lbdem_core::simd::level().name().to_string(),
         stages,
         total_wall_s: wall_s,
     }

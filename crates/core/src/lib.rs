@@ -6,5 +6,6 @@
 //! do I/O; the writers here are called by stages and scenes, not by kernels.
 
 pub mod atomic;
+pub mod simd;
 pub mod units;
 pub mod vtk;

@@ -21,6 +21,7 @@
 use crate::error::CouplingError;
 use crate::solid_fraction::{CellCover, SolidMap};
 use crate::weighting::psm_weight;
+use lbdem_core::simd::{self, Simd, WithSimd};
 use lbdem_lbm::collision::{CollideParams, Collider, LocalRates, NodeRates, local_rates};
 use lbdem_lbm::lattice::QMAX;
 use lbdem_lbm::plan::{Upstream, neighbour};
@@ -818,16 +819,39 @@ fn run_chunks<T: Real, L: Lattice, C: Collider<L, f64>>(
     tasks
         .into_par_iter()
         .map(|c| {
-            if forced {
-                chunk::<T, L, C, true>(base, &coll, c)
-            } else {
-                chunk::<T, L, C, false>(base, &coll, c)
-            }
+            simd::dispatch(ChunkOp::<T, L, C> {
+                base,
+                coll: &coll,
+                chunk: c,
+                forced,
+                _l: PhantomData,
+            })
         })
         .collect::<Vec<_>>()
         .into_iter()
         .flatten()
         .next()
+}
+
+/// One chunk, compiled for each instruction-set level (`lbdem_core::simd`).
+struct ChunkOp<'a, T, L, C> {
+    base: &'a Base<'a, T>,
+    coll: &'a C,
+    chunk: Chunk<'a, T>,
+    forced: bool,
+    _l: PhantomData<L>,
+}
+
+impl<T: Real, L: Lattice, C: Collider<L, f64>> WithSimd for ChunkOp<'_, T, L, C> {
+    type Output = Option<(usize, f64, [f64; 3])>;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) -> Self::Output {
+        if self.forced {
+            chunk::<T, L, C, true>(self.base, self.coll, self.chunk)
+        } else {
+            chunk::<T, L, C, false>(self.base, self.coll, self.chunk)
+        }
+    }
 }
 
 /// One chunk of nodes: pull-stream (Su Eq. 12) with bounce-back from walls and inactive nodes,
@@ -840,6 +864,7 @@ fn run_chunks<T: Real, L: Lattice, C: Collider<L, f64>>(
 /// node receives exactly (1 − B) F of momentum), B from Eq. 10, B_s = B ε_s / ε so that
 /// Σ_s B_s = B, and Ω^s the solid term of Eq. 11. The load on grain s is the reaction to the
 /// momentum Ω^s puts into the liquid (Eq. 14).
+#[inline(always)] // into each instruction-set level's copy
 fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
     b: &Base<T>,
     coll: &C,

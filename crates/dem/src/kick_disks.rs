@@ -4,19 +4,20 @@
 //! left to that loop.
 
 use crate::domain::Domain;
-use crate::lanes::{F8, W, deinterleave, interleave, transpose};
+use crate::lanes::W;
 use crate::scratch::CircleState;
 use crate::vector::Vec2;
+use lbdem_core::simd::{self, Simd, WithSimd};
 
 /// Box constants of one pass.
 pub(crate) struct DiskKick {
-    dt: F8,
-    lo: [F8; 2],
-    hi: [F8; 2],
-    len: [F8; 2],
+    pub(crate) dt: f64,
+    pub(crate) lo: [f64; 2],
+    pub(crate) hi: [f64; 2],
+    pub(crate) len: [f64; 2],
     /// Half box length on periodic axes, infinite on open ones (no minimum-image shift).
-    half: [F8; 2],
-    periodic: [bool; 2],
+    pub(crate) half: [f64; 2],
+    pub(crate) periodic: [bool; 2],
 }
 
 /// The state of eight disks the pass reads and writes.
@@ -36,12 +37,12 @@ pub(crate) struct Eight<'a> {
     pub hi: [f64; W],
 }
 
-fn pairs(v: &[Vec2; W]) -> &[[f64; 2]; W] {
+pub(crate) fn pairs(v: &[Vec2; W]) -> &[[f64; 2]; W] {
     // SAFETY: Vec2 is repr(C): two f64, no padding.
     unsafe { &*(v as *const [Vec2; W]).cast::<[[f64; 2]; W]>() }
 }
 
-fn pairs_mut(v: &mut [Vec2; W]) -> &mut [[f64; 2]; W] {
+pub(crate) fn pairs_mut(v: &mut [Vec2; W]) -> &mut [[f64; 2]; W] {
     // SAFETY: as above.
     unsafe { &mut *(v as *mut [Vec2; W]).cast::<[[f64; 2]; W]>() }
 }
@@ -49,12 +50,12 @@ fn pairs_mut(v: &mut [Vec2; W]) -> &mut [[f64; 2]; W] {
 impl DiskKick {
     pub(crate) fn new(dom: &Domain, dt: f64) -> Self {
         let l = dom.size();
-        let half = |p: bool, v: f64| F8::splat(if p { 0.5 * v } else { f64::INFINITY });
+        let half = |p: bool, v: f64| if p { 0.5 * v } else { f64::INFINITY };
         Self {
-            dt: F8::splat(dt),
-            lo: [F8::splat(dom.lo.x), F8::splat(dom.lo.y)],
-            hi: [F8::splat(dom.hi.x), F8::splat(dom.hi.y)],
-            len: [F8::splat(l.x), F8::splat(l.y)],
+            dt,
+            lo: [dom.lo.x, dom.lo.y],
+            hi: [dom.hi.x, dom.hi.y],
+            len: [l.x, l.y],
             half: [half(dom.periodic[0], l.x), half(dom.periodic[1], l.y)],
             periodic: dom.periodic,
         }
@@ -62,67 +63,44 @@ impl DiskKick {
 
     /// Kick, drift and lines of eight disks; the largest squared displacement since the list
     /// build (NaN if any is NaN), or None (nothing written) if a disk must take the far wrap.
+    /// The AVX-512 lane copy where the CPU has it, else the array copy compiled for the level
+    /// of `lbdem_core::simd`.
     #[inline(always)]
     pub(crate) fn eight(&self, e: Eight<'_>) -> Option<f64> {
-        let (fx, fy) = deinterleave(pairs(e.f));
-        let (mut vx, mut vy) = deinterleave(pairs(e.v));
-        let (x0, y0) = deinterleave(pairs(e.x));
-        let (hm, hi) = (F8::from_array(e.hm), F8::from_array(e.hi));
-        // v += F (h/m); ω += T (h/I)
-        vx = vx + fx * hm;
-        vy = vy + fy * hm;
-        let w = F8::from_array(*e.w) + F8::from_array(*e.t) * hi;
-        // x = wrap(x + v dt): one conditional shift per periodic axis (Domain::wrap)
-        let wrap = |p: F8, k: usize| {
-            if self.periodic[k] {
-                let below = p.lt(self.lo[k]);
-                let above = p.ge(self.hi[k]);
-                below.select(p + self.len[k], above.select(p - self.len[k], p))
-            } else {
-                p
+        #[cfg(target_arch = "x86_64")]
+        {
+            if crate::lanes::NATIVE_AVX512 {
+                // The build targets AVX-512: the lane code inlines here (a call through
+                // `eight_avx512` cost 8 % of the 10k DEM bench).
+                return crate::on_avx512::kick::eight(self, e);
             }
-        };
-        let x = wrap(x0 + vx * self.dt, 0);
-        let y = wrap(y0 + vy * self.dt, 1);
-        let far = |p: F8, k: usize| self.periodic[k] && p.outside(self.lo[k], self.hi[k]).any();
-        if far(x, 0) || far(y, 1) {
-            return None;
+            if crate::lanes::avx512_ok() {
+                // SAFETY: the CPU has the features `eight_avx512` enables (`avx512_ok`).
+                return unsafe { eight_avx512(self, e) };
+            }
         }
-        let a = F8::from_array(*e.a) + w * self.dt;
-        // Displacement since the list build (Domain::min_image, norm2).
-        let (rx, ry) = deinterleave(pairs(e.refp));
-        let min_image = |d: F8, k: usize| {
-            let shift = d.abs().gt(self.half[k]);
-            shift.select(d - self.len[k].copysign(d), d)
-        };
-        let (dx, dy) = (min_image(x - rx, 0), min_image(y - ry, 1));
-        let d2 = (dx * dx + dy * dy).to_array();
-        interleave(vx, vy, pairs_mut(e.v));
-        interleave(x, y, pairs_mut(e.x));
-        *e.w = w.to_array();
-        *e.a = a.to_array();
-        let rows = transpose([
-            x,
-            y,
-            vx,
-            vy,
-            w,
-            F8::from_array(*e.r),
-            F8::from_array(*e.m),
-            F8::splat(0.0),
-        ]);
-        for (s, row) in e.st.iter_mut().zip(rows) {
-            *s = CircleState {
-                pos: Vec2::new(row[0], row[1]),
-                vel: Vec2::new(row[2], row[3]),
-                omega: row[4],
-                r: row[5],
-                mass: row[6],
-                pad: 0.0,
-            };
-        }
-        Some(d2.into_iter().fold(0.0, crate::scratch::nan_max))
+        simd::dispatch(EightOp { k: self, e })
     }
+}
+
+struct EightOp<'a, 'b> {
+    k: &'a DiskKick,
+    e: Eight<'b>,
+}
+
+impl WithSimd for EightOp<'_, '_> {
+    type Output = Option<f64>;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) -> Option<f64> {
+        crate::on_arrays::kick::eight(self.k, self.e)
+    }
+}
+
+/// The AVX-512 lane copy, compiled with the features its intrinsics need.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw,avx512cd")]
+unsafe fn eight_avx512(k: &DiskKick, e: Eight<'_>) -> Option<f64> {
+    crate::on_avx512::kick::eight(k, e)
 }
 
 #[cfg(test)]

@@ -17,6 +17,9 @@ pub mod history;
 mod kick_disks;
 mod lanes;
 pub mod neighbor;
+mod on_arrays;
+#[cfg(target_arch = "x86_64")]
+mod on_avx512;
 mod pair_linear;
 pub mod polygon;
 mod scratch;

@@ -19,7 +19,6 @@ pub(crate) struct CircleState {
 
 impl CircleState {
     /// The line as eight numbers: x, y, vx, vy, ω, r, m, 0 (portable pair kernel).
-    #[cfg(not(target_feature = "avx512f"))]
     #[inline(always)]
     pub(crate) fn line(&self) -> [f64; 8] {
         [

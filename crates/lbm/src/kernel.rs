@@ -130,6 +130,7 @@ pub struct Ctx<'a, T, C> {
 /// # Safety
 /// `ctx.dst` (and `ctx.out`) must point to arrays of the right length, and no other thread may
 /// write row `r` during the call.
+#[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
 pub unsafe fn row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(ctx: &Ctx<T, C>, r: usize) -> bool {
     let dom = ctx.dom;
     let [nx, ny, _] = dom.n;

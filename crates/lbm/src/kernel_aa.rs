@@ -87,6 +87,7 @@ fn first_bad<T: Real, C, const B: usize>(
 ///
 /// # Safety
 /// `ctx.f` must hold Q `ctx.layout.stride` values; no other thread may touch the nodes of row `r`.
+#[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
 pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
     ctx: &CtxAa<T, C>,
     r: usize,
@@ -198,6 +199,7 @@ unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB:
 /// # Safety
 /// As `even_row`; the slots a node touches are its own (see the module doc), so rows may run
 /// concurrently.
+#[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
 pub unsafe fn odd_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
     ctx: &CtxAa<T, C>,
     r: usize,

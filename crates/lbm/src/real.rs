@@ -67,26 +67,14 @@ impl Real for f64 {
     fn mul_add(self, a: Self, b: Self) -> Self {
         f64::mul_add(self, a, b)
     }
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
     #[inline(always)]
     fn bad_block<const B: usize>(rho: &[Self; B], usq: &[Self; B], lo: Self, hi: Self, um: Self) -> u32 {
-        use std::arch::x86_64::*;
-        if !B.is_multiple_of(8) || B > 32 {
-            return bad_scalar(rho, usq, lo, hi, um);
+        #[cfg(target_arch = "x86_64")]
+        if avx512() {
+            // SAFETY: the CPU has AVX-512F (`avx512`).
+            return unsafe { v4::bad_block_f64(rho, usq, lo, hi, um) };
         }
-        let mut ok = 0u32;
-        for k in 0..B / 8 {
-            // SAFETY: 8 values from offset 8k < B; the target has AVX-512F (cfg).
-            let m = unsafe {
-                let r = _mm512_loadu_pd(rho.as_ptr().add(8 * k));
-                let u = _mm512_loadu_pd(usq.as_ptr().add(8 * k));
-                let m = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r, _mm512_set1_pd(lo));
-                let m = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(m, r, _mm512_set1_pd(hi));
-                _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(m, u, _mm512_set1_pd(um))
-            };
-            ok |= u32::from(m) << (8 * k);
-        }
-        !ok & lanes(B)
+        bad_scalar(rho, usq, lo, hi, um)
     }
 }
 
@@ -104,16 +92,75 @@ impl Real for f32 {
     fn mul_add(self, a: Self, b: Self) -> Self {
         f32::mul_add(self, a, b)
     }
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
     #[inline(always)]
     fn bad_block<const B: usize>(rho: &[Self; B], usq: &[Self; B], lo: Self, hi: Self, um: Self) -> u32 {
-        use std::arch::x86_64::*;
+        #[cfg(target_arch = "x86_64")]
+        if avx512() {
+            // SAFETY: the CPU has AVX-512F (`avx512`).
+            return unsafe { v4::bad_block_f32(rho, usq, lo, hi, um) };
+        }
+        bad_scalar(rho, usq, lo, hi, um)
+    }
+}
+
+/// Whether the AVX-512 range check may run: always in a `target-cpu=native` build for an
+/// AVX-512 CPU, else when `lbdem_core::simd` runs the kernels at that level (one cached load
+/// per block; in the other levels' copies the branch is never taken).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn avx512() -> bool {
+    cfg!(target_feature = "avx512f") || lbdem_core::simd::level() == lbdem_core::simd::Level::V4
+}
+
+/// The range check as three masked vector compares per register. Callable from any code
+/// (`#[target_feature]`); inlined into the AVX-512 copy of a kernel.
+#[cfg(target_arch = "x86_64")]
+mod v4 {
+    use super::{bad_scalar, lanes};
+    use std::arch::x86_64::*;
+
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    pub(super) unsafe fn bad_block_f64<const B: usize>(
+        rho: &[f64; B],
+        usq: &[f64; B],
+        lo: f64,
+        hi: f64,
+        um: f64,
+    ) -> u32 {
+        if !B.is_multiple_of(8) || B > 32 {
+            return bad_scalar(rho, usq, lo, hi, um);
+        }
+        let mut ok = 0u32;
+        for k in 0..B / 8 {
+            // SAFETY: 8 values from offset 8k < B; the caller checked AVX-512F.
+            let m = unsafe {
+                let r = _mm512_loadu_pd(rho.as_ptr().add(8 * k));
+                let u = _mm512_loadu_pd(usq.as_ptr().add(8 * k));
+                let m = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(r, _mm512_set1_pd(lo));
+                let m = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(m, r, _mm512_set1_pd(hi));
+                _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(m, u, _mm512_set1_pd(um))
+            };
+            ok |= u32::from(m) << (8 * k);
+        }
+        !ok & lanes(B)
+    }
+
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    pub(super) unsafe fn bad_block_f32<const B: usize>(
+        rho: &[f32; B],
+        usq: &[f32; B],
+        lo: f32,
+        hi: f32,
+        um: f32,
+    ) -> u32 {
         if !B.is_multiple_of(16) || B > 32 {
             return bad_scalar(rho, usq, lo, hi, um);
         }
         let mut ok = 0u32;
         for k in 0..B / 16 {
-            // SAFETY: 16 values from offset 16k < B; the target has AVX-512F (cfg).
+            // SAFETY: 16 values from offset 16k < B; the caller checked AVX-512F.
             let m = unsafe {
                 let r = _mm512_loadu_ps(rho.as_ptr().add(16 * k));
                 let u = _mm512_loadu_ps(usq.as_ptr().add(16 * k));

@@ -11,6 +11,7 @@ use crate::kernel::{self, Ctx, Limits, MacroOut, SyncPtr};
 use crate::lattice::{Lattice, QMAX};
 use crate::plan::Plan;
 use crate::real::Real;
+use lbdem_core::simd::{self, Simd, WithSimd};
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -125,18 +126,41 @@ fn run_rows<L: Lattice, T: Real, C: Collider<L, T>>(row_good: &mut [bool], ctx: 
         .par_chunks_mut(ROWS_PER_TASK)
         .enumerate()
         .for_each(|(c, flags)| {
-            for (k, g) in flags.iter_mut().enumerate() {
-                let r = c * ROWS_PER_TASK + k;
-                // SAFETY: each row index belongs to exactly one chunk.
-                *g = unsafe {
-                    if forced {
-                        kernel::row::<L, T, C, true>(ctx, r)
-                    } else {
-                        kernel::row::<L, T, C, false>(ctx, r)
-                    }
-                };
-            }
+            simd::dispatch(Rows::<L, T, C> {
+                ctx,
+                first: c * ROWS_PER_TASK,
+                flags,
+                forced,
+                _l: PhantomData,
+            })
         });
+}
+
+/// One task's rows, compiled for each instruction-set level (`lbdem_core::simd`).
+struct Rows<'a, L, T, C> {
+    ctx: &'a Ctx<'a, T, C>,
+    first: usize,
+    flags: &'a mut [bool],
+    forced: bool,
+    _l: PhantomData<L>,
+}
+
+impl<L: Lattice, T: Real, C: Collider<L, T>> WithSimd for Rows<'_, L, T, C> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        for (k, g) in self.flags.iter_mut().enumerate() {
+            let r = self.first + k;
+            // SAFETY: each row index belongs to exactly one chunk.
+            *g = unsafe {
+                if self.forced {
+                    kernel::row::<L, T, C, true>(self.ctx, r)
+                } else {
+                    kernel::row::<L, T, C, false>(self.ctx, r)
+                }
+            };
+        }
+    }
 }
 
 /// Per-node rates from `tau` (shared by both steppers); sets `params.bgk` for the block path.

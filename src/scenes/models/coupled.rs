@@ -184,14 +184,15 @@ impl<T: Real> CoupledModel<T> {
         if !crate::contract::quiet() {
             eprintln!(
                 "coupled: {} grains, lattice {nx} x {ny} (dx = {:e} m, tau = {tau:.4}), LBM dt = {:e} s, \
-             DEM dt = {:e} s, ratio {}, {:?}, {}",
+             DEM dt = {:e} s, ratio {}, {:?}, {}, SIMD {}",
                 run.sys.bodies.len(),
                 run.units.dx(),
                 run.units.dt(),
                 run.units.dt_dem,
                 run.units.ratio,
                 cs.method,
-                T::NAME
+                T::NAME,
+                lbdem_core::simd::level().name()
             );
         }
         let threads = s.run.threads;

@@ -38,10 +38,11 @@ impl Dry {
         let (crit, m_min, k_max) = Stepper::critical_time_step(&sys, &law, &wall_law);
         if !crate::contract::quiet() {
             eprintln!(
-                "dem: {} bodies, dt = {:e} s, critical {crit:e} s (m_min {m_min:e} kg, k_max {k_max:e} N/m), law {}",
+                "dem: {} bodies, dt = {:e} s, critical {crit:e} s (m_min {m_min:e} kg, k_max {k_max:e} N/m), law {}, SIMD {}",
                 sys.bodies.len(),
                 params.dt,
-                law_name(&law)
+                law_name(&law),
+                lbdem_core::simd::level().name()
             );
         }
         let mut stepper = Stepper::new();

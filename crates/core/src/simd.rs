@@ -1,0 +1,168 @@
+//! The instruction set the kernels run with, chosen once at run time, so that one binary runs
+//! on any x86-64 and still takes AVX-512 (x86-64-v4) or AVX2 + FMA (v3) where the CPU has them.
+//!
+//! A kernel is written once, as portable Rust the compiler auto-vectorises, and called through
+//! [`dispatch`]: `pulp` compiles it once per level inside a `#[target_feature]` function and
+//! picks the best level the CPU reports. Every level gives the same bits: Rust never contracts
+//! `a * b + c` into a fused multiply-add on its own (the kernels' explicit `mul_add` is
+//! correctly rounded on every level, in hardware or in libm) and never reorders a
+//! floating-point sum, so vector width changes how fast a kernel runs, not what it computes.
+//! `LBDEM_ISA=portable` forces the baseline path (the bit-identity tests and users who suspect
+//! a miscompiled path use it); a level above what the CPU has is never taken.
+//!
+//! STATUS (issue 17 item 8, open): the repository's `.cargo/config.toml` still builds for the
+//! native CPU, because the portable build is slower here (docs/performance.md, "Portable
+//! binaries"): LBM 9-21 %, DEM 2.4x, where closures and the rest of the DEM stepper run at the
+//! baseline level. A native build compiles every level alike ([`NATIVE_V4`]).
+
+use std::sync::OnceLock;
+
+pub use pulp::{Arch, Simd, WithSimd};
+
+/// The environment variable that caps the level: `portable`, `v3` or `v4` (case-insensitive).
+pub const ISA_ENV: &str = "LBDEM_ISA";
+
+/// A level of the x86-64 psABI the kernels are compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Level {
+    /// x86-64 baseline (SSE2), or any non-x86 target.
+    Portable,
+    /// x86-64-v3: AVX2, FMA, BMI2.
+    V3,
+    /// x86-64-v4: AVX-512 F/BW/CD/DQ/VL.
+    V4,
+}
+
+impl Level {
+    pub fn name(self) -> &'static str {
+        match self {
+            Level::Portable => "portable",
+            Level::V3 => "x86-64-v3 (AVX2, FMA)",
+            Level::V4 => "x86-64-v4 (AVX-512)",
+        }
+    }
+
+    fn of(arch: Arch) -> Level {
+        match arch {
+            #[cfg(target_arch = "x86_64")]
+            Arch::V4(_) => Level::V4,
+            #[cfg(target_arch = "x86_64")]
+            Arch::V3(_) => Level::V3,
+            _ => Level::Portable,
+        }
+    }
+}
+
+/// `LBDEM_ISA` holds a value that names no level.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "environment variable {ISA_ENV} = {value:?} names no instruction-set level; use `portable`, `v3` or `v4`, \
+     or unset it to take the best level this CPU has"
+)]
+pub struct UnknownLevel {
+    pub value: String,
+}
+
+/// The cap `LBDEM_ISA` sets, if any. The command line calls this first, so a typo is refused
+/// before anything runs; [`arch`] ignores a value this refuses.
+pub fn requested() -> Result<Option<Level>, UnknownLevel> {
+    match std::env::var(ISA_ENV) {
+        Err(_) => Ok(None),
+        Ok(v) => match v.trim().to_ascii_lowercase().as_str() {
+            "portable" | "scalar" | "baseline" => Ok(Some(Level::Portable)),
+            "v3" | "avx2" => Ok(Some(Level::V3)),
+            "v4" | "avx512" | "avx-512" => Ok(Some(Level::V4)),
+            _ => Err(UnknownLevel { value: v }),
+        },
+    }
+}
+
+/// The best level the CPU has, capped by `LBDEM_ISA`; detected once per process.
+pub fn arch() -> Arch {
+    static ARCH: OnceLock<Arch> = OnceLock::new();
+    *ARCH.get_or_init(|| {
+        let best = Arch::new();
+        match requested().ok().flatten() {
+            Some(cap) if cap < Level::of(best) => capped(cap),
+            _ => best,
+        }
+    })
+}
+
+/// The best level at or under `cap` (the CPU has every level under its best).
+fn capped(cap: Level) -> Arch {
+    #[cfg(target_arch = "x86_64")]
+    if cap == Level::V3
+        && let Some(v3) = pulp::x86::V3::try_new()
+    {
+        return Arch::V3(v3);
+    }
+    let _ = cap;
+    Arch::Scalar
+}
+
+/// The level [`dispatch`] runs kernels with in this process.
+pub fn level() -> Level {
+    if NATIVE_V4 { Level::V4 } else { Level::of(arch()) }
+}
+
+/// Run `op` compiled for the level of [`arch`]. `op.with_simd` must be `#[inline(always)]`
+/// and call only `#[inline(always)]` code on its hot path: what it calls out of line is
+/// compiled for the baseline.
+///
+/// A build for the native CPU (`-C target-cpu=native` on an AVX-512 machine) compiles every
+/// function at that level already: it runs `op` once, without copies.
+#[inline(always)]
+pub fn dispatch<Op: WithSimd>(op: Op) -> Op::Output {
+    if NATIVE_V4 {
+        return op.with_simd(pulp::Scalar::new());
+    }
+    arch().dispatch(op)
+}
+
+/// The whole build targets AVX-512 (x86-64-v4) already.
+pub const NATIVE_V4: bool = cfg!(all(
+    target_arch = "x86_64",
+    target_feature = "avx512f",
+    target_feature = "avx512dq",
+    target_feature = "avx512vl",
+    target_feature = "avx512bw",
+    target_feature = "avx512cd",
+    target_feature = "fma"
+));
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Sum<'a>(&'a [f64]);
+    impl WithSimd for Sum<'_> {
+        type Output = f64;
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, _: S) -> f64 {
+            self.0
+                .iter()
+                .fold(0.0, |a, &x| x.mul_add(1.000_000_1, a) * 0.999_999_9)
+        }
+    }
+
+    #[test]
+    fn every_level_this_cpu_has_gives_the_same_bits() {
+        let v: Vec<f64> = (0..1000).map(|k| (k as f64 * 0.37).sin() * 1e3).collect();
+        let scalar = Arch::Scalar.dispatch(Sum(&v));
+        let best = Arch::new();
+        assert_eq!(
+            scalar.to_bits(),
+            best.dispatch(Sum(&v)).to_bits(),
+            "level {:?}",
+            Level::of(best)
+        );
+        assert_eq!(scalar.to_bits(), capped(Level::V3).dispatch(Sum(&v)).to_bits());
+    }
+
+    #[test]
+    fn a_cap_never_raises_the_level() {
+        assert_eq!(Level::of(capped(Level::Portable)), Level::Portable);
+        assert!(Level::of(capped(Level::V3)) <= Level::V3);
+    }
+}
