@@ -159,7 +159,17 @@ fn stage_command(name: &'static str, kind: &'static StageKind) -> Command {
 pub fn main() -> Result<()> {
     let m = command().get_matches();
     // A typo in LBDEM_ISA is refused before anything runs (the kernels would ignore it).
-    lbdem_core::simd::requested()?;
+    if let Some(cap) = lbdem_core::simd::requested()?
+        && lbdem_core::simd::NATIVE_V4
+        && cap < lbdem_core::simd::Level::V4
+    {
+        eprintln!(
+            "warning: {} = {} has no effect: this binary was built for the native CPU (x86-64-v4), every \
+             function runs at that level; build a portable binary (RUSTFLAGS=\"-C target-cpu=x86-64\") to use the cap",
+            lbdem_core::simd::ISA_ENV,
+            cap.name()
+        );
+    }
     match m.subcommand() {
         Some(("run", a)) => {
             let path = a.get_one::<PathBuf>("pipeline").context("PIPELINE is required")?;

@@ -7,13 +7,15 @@
 //! `a * b + c` into a fused multiply-add on its own (the kernels' explicit `mul_add` is
 //! correctly rounded on every level, in hardware or in libm) and never reorders a
 //! floating-point sum, so vector width changes how fast a kernel runs, not what it computes.
-//! `LBDEM_ISA=portable` forces the baseline path (the bit-identity tests and users who suspect
-//! a miscompiled path use it); a level above what the CPU has is never taken.
+//! `LBDEM_ISA=portable` forces the baseline path in a portable build (for users who suspect a
+//! miscompiled path, and for bit comparisons); a level above what the CPU has is never taken.
+//! A native build compiles every function for its CPU already: there the cap changes nothing,
+//! and the command line says so.
 //!
 //! STATUS (issue 17 item 8, open): the repository's `.cargo/config.toml` still builds for the
 //! native CPU, because the portable build is slower here (docs/performance.md, "Portable
-//! binaries"): LBM 9-21 %, DEM 2.4x, where closures and the rest of the DEM stepper run at the
-//! baseline level. A native build compiles every level alike ([`NATIVE_V4`]).
+//! binaries"): 0.79-1.05x on the LBM benches, 0.41x on the DEM bench, where the lane kernels'
+//! closures and the rest of the DEM stepper run at the baseline level. A native build compiles every level alike ([`NATIVE_V4`]).
 
 use std::sync::OnceLock;
 
@@ -78,6 +80,7 @@ pub fn requested() -> Result<Option<Level>, UnknownLevel> {
 }
 
 /// The best level the CPU has, capped by `LBDEM_ISA`; detected once per process.
+#[inline]
 pub fn arch() -> Arch {
     static ARCH: OnceLock<Arch> = OnceLock::new();
     *ARCH.get_or_init(|| {
@@ -102,6 +105,7 @@ fn capped(cap: Level) -> Arch {
 }
 
 /// The level [`dispatch`] runs kernels with in this process.
+#[inline]
 pub fn level() -> Level {
     if NATIVE_V4 { Level::V4 } else { Level::of(arch()) }
 }

@@ -178,6 +178,27 @@ mod tests {
                     );
                     worst = crate::scratch::nan_max(worst, d);
                 }
+                // The array lane copy on the same inputs: the machine's own path (AVX-512
+                // here) is checked below, this one must give the same bits too.
+                let (mut x2, mut v2, mut a2, mut w2) = (x, v, a, w);
+                let mut st2 = [CircleState::default(); W];
+                let got2 = crate::on_arrays::kick::eight(
+                    &DiskKick::new(&dom, dt),
+                    Eight {
+                        x: &mut x2,
+                        v: &mut v2,
+                        a: &mut a2,
+                        w: &mut w2,
+                        st: &mut st2,
+                        f: &f,
+                        t: &t,
+                        r: &r,
+                        m: &m,
+                        refp: &refp,
+                        hm,
+                        hi,
+                    },
+                );
                 let mut st = [CircleState::default(); W];
                 let got = DiskKick::new(&dom, dt).eight(Eight {
                     x: &mut x,
@@ -199,6 +220,14 @@ mod tests {
                 assert_eq!(bits(&v), bits(&vs));
                 assert_eq!(a.map(f64::to_bits), as_.map(f64::to_bits));
                 assert_eq!(w.map(f64::to_bits), ws.map(f64::to_bits));
+                assert_eq!(got2.map(f64::to_bits), Some(worst.to_bits()), "array lanes");
+                assert_eq!(bits(&x2), bits(&xs), "array lanes");
+                assert_eq!(bits(&v2), bits(&vs), "array lanes");
+                assert_eq!(a2.map(f64::to_bits), as_.map(f64::to_bits), "array lanes");
+                assert_eq!(w2.map(f64::to_bits), ws.map(f64::to_bits), "array lanes");
+                for k in 0..W {
+                    assert_eq!((st2[k].pos, st2[k].vel, st2[k].omega), (xs[k], vs[k], ws[k]));
+                }
                 for k in 0..W {
                     assert_eq!((st[k].pos, st[k].vel, st[k].omega), (xs[k], vs[k], ws[k]));
                     assert_eq!((st[k].r, st[k].mass), (r[k], m[k]));

@@ -104,8 +104,8 @@ impl Real for f32 {
 }
 
 /// Whether the AVX-512 range check may run: always in a `target-cpu=native` build for an
-/// AVX-512 CPU, else when `lbdem_core::simd` runs the kernels at that level (one cached load
-/// per block; in the other levels' copies the branch is never taken).
+/// AVX-512 CPU, else when `lbdem_core::simd` runs the kernels at that level (a `OnceLock` read
+/// per block of 16 or 32 nodes; in the other levels' copies the branch is never taken).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn avx512() -> bool {

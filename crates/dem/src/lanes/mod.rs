@@ -15,14 +15,19 @@ pub(crate) mod portable;
 /// Lanes per batch (eight f64 = one AVX-512 register).
 pub(crate) const W: usize = 8;
 
-/// The whole build targets a CPU with AVX-512 F and DQ (`-C target-cpu=native` here): the
-/// AVX-512 copies are called directly, without a `#[target_feature]` call in between.
-pub(crate) const NATIVE_AVX512: bool = cfg!(all(target_feature = "avx512f", target_feature = "avx512dq"));
+/// The whole build targets x86-64-v4 (`-C target-cpu=native` here): the AVX-512 copies are
+/// called directly, without a `#[target_feature]` call in between.
+pub(crate) const NATIVE_AVX512: bool = lbdem_core::simd::NATIVE_V4;
 
-/// Whether the AVX-512 copies may run: the build targets such a CPU, or `lbdem_core::simd`
-/// runs this process at x86-64-v4 (detected on the CPU, not capped by `LBDEM_ISA`).
+/// Whether the AVX-512 copies may run: `lbdem_core::simd` runs this process at x86-64-v4
+/// (the CPU has every feature the copies' `#[target_feature]` entries enable). `LBDEM_ISA`
+/// below v4 turns them off, except in a native build (`NATIVE_AVX512`), where every function
+/// is compiled for v4 anyway.
+///
+/// The functions of `avx512` and of `crate::on_avx512` are safe to call only under this (or
+/// `NATIVE_AVX512`); they are reached only through `pair_linear.rs` and `kick_disks.rs`.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) fn avx512_ok() -> bool {
-    NATIVE_AVX512 || lbdem_core::simd::level() == lbdem_core::simd::Level::V4
+    lbdem_core::simd::level() == lbdem_core::simd::Level::V4
 }
