@@ -7,8 +7,25 @@ use crate::lanes::W;
 use crate::pair_linear::LinearPair;
 use crate::scratch::{CircleState, PairOut};
 
+/// Every pair of `pairs`, the damping form chosen once per call.
 #[inline(always)]
-pub(crate) fn run_damp<const GAMMA: bool>(
+pub(crate) fn run(
+    kp: &LinearPair,
+    cst: &[CircleState],
+    pairs: &[[u32; 2]],
+    hist: &mut [History],
+    out: &mut [PairOut],
+    touch: &mut [u8],
+) {
+    if kp.gamma {
+        run_damp::<true>(kp, cst, pairs, hist, out, touch);
+    } else {
+        run_damp::<false>(kp, cst, pairs, hist, out, touch);
+    }
+}
+
+#[inline(always)]
+fn run_damp<const GAMMA: bool>(
     kp: &LinearPair,
     cst: &[CircleState],
     pairs: &[[u32; 2]],

@@ -68,13 +68,7 @@ impl LinearPair {
         {
             if crate::lanes::NATIVE_AVX512 {
                 // The build targets AVX-512: no `#[target_feature]` call in between.
-                use crate::on_avx512::pair::run_damp;
-                if self.gamma {
-                    run_damp::<true>(self, cst, pairs, hist, out, touch);
-                } else {
-                    run_damp::<false>(self, cst, pairs, hist, out, touch);
-                }
-                return;
+                return crate::on_avx512::pair::run(self, cst, pairs, hist, out, touch);
             }
             if crate::lanes::avx512_ok() {
                 // SAFETY: the CPU has the features `run_avx512` enables (`avx512_ok`).
@@ -103,12 +97,7 @@ unsafe fn run_avx512(
     out: &mut [PairOut],
     touch: &mut [u8],
 ) {
-    use crate::on_avx512::pair::run_damp;
-    if k.gamma {
-        run_damp::<true>(k, cst, pairs, hist, out, touch);
-    } else {
-        run_damp::<false>(k, cst, pairs, hist, out, touch);
-    }
+    crate::on_avx512::pair::run(k, cst, pairs, hist, out, touch)
 }
 
 /// The array lane copy, compiled for each instruction-set level (`lbdem_core::simd`).
@@ -125,7 +114,6 @@ impl WithSimd for Run<'_> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: Simd>(self, _: S) {
-        use crate::on_arrays::pair::run_damp;
         let Run {
             k,
             cst,
@@ -134,10 +122,6 @@ impl WithSimd for Run<'_> {
             out,
             touch,
         } = self;
-        if k.gamma {
-            run_damp::<true>(k, cst, pairs, hist, out, touch);
-        } else {
-            run_damp::<false>(k, cst, pairs, hist, out, touch);
-        }
+        crate::on_arrays::pair::run(k, cst, pairs, hist, out, touch)
     }
 }
