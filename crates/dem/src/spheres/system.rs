@@ -1,0 +1,164 @@
+//! The state of a sphere assembly, plain data and serialisable: spheres, plane walls, the
+//! Verlet list with its contact histories, the clock. A checkpoint is this struct written with
+//! `serde_json` (`float_roundtrip`); a run resumed from it continues bit for bit, because every
+//! quantity the step reads — the last forces, the pair list and the positions it was built at —
+//! is here, and the stepper holds only scratch.
+
+use super::domain::Domain3;
+use super::error::SphereError;
+use crate::vector::{Vec3, Vector};
+use serde::{Deserialize, Serialize};
+
+/// The spheres, one entry per sphere in every array (structure of arrays).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Spheres {
+    pub pos: Vec<Vec3>,
+    pub vel: Vec<Vec3>,
+    /// Angular velocity ω (rad/s).
+    pub omega: Vec<Vec3>,
+    /// Total force of the last step (contacts and gravity), N.
+    pub force: Vec<Vec3>,
+    /// Total torque of the last step about the centre, N m.
+    pub torque: Vec<Vec3>,
+    pub radius: Vec<f64>,
+    pub mass: Vec<f64>,
+    /// Moment of inertia about the centre, (2/5) m r² for a solid sphere.
+    pub inertia: Vec<f64>,
+}
+
+impl Spheres {
+    pub fn len(&self) -> usize {
+        self.pos.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.pos.is_empty()
+    }
+}
+
+/// An infinite plane wall: spheres live on the side its normal points to.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneWall {
+    /// A point of the plane (moves with `vel`).
+    pub point: Vec3,
+    /// Unit normal, pointing into the region of the spheres.
+    pub normal: Vec3,
+    /// Translation velocity (m/s).
+    #[serde(default)]
+    pub vel: Vec3,
+}
+
+impl PlaneWall {
+    /// A fixed plane through `point` with normal `normal` (normalised here).
+    pub fn new(point: Vec3, normal: Vec3) -> Result<Self, SphereError> {
+        let l = normal.norm();
+        if !(l > 0.0 && l.is_finite() && point.is_finite()) {
+            return Err(SphereError::BadParameter {
+                name: "wall normal length",
+                value: l,
+                why: "a plane wall needs a finite point and a non-zero, finite normal",
+            });
+        }
+        Ok(Self {
+            point,
+            normal: normal * (1.0 / l),
+            vel: Vec3::ZERO,
+        })
+    }
+}
+
+/// The Verlet pair list and the contact histories (tangential springs ξ).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SphereContacts {
+    /// Candidate pairs (i < j), sorted.
+    pub pairs: Vec<[u32; 2]>,
+    /// Tangential spring of each pair (zero when not in contact).
+    pub xi: Vec<Vec3>,
+    /// Tangential spring of each sphere-wall contact, index `sphere * n_walls + wall`.
+    pub wall_xi: Vec<Vec3>,
+    /// Sphere positions when the list was built (the rebuild test reads them).
+    pub list_ref: Vec<Vec3>,
+}
+
+/// A sphere assembly: state only (see the module docs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SphereSystem {
+    pub domain: Domain3,
+    pub spheres: Spheres,
+    pub walls: Vec<PlaneWall>,
+    pub contacts: SphereContacts,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Steps taken.
+    pub step: u64,
+}
+
+impl SphereSystem {
+    pub fn new(domain: Domain3) -> Self {
+        Self {
+            domain,
+            spheres: Spheres::default(),
+            walls: Vec::new(),
+            contacts: SphereContacts::default(),
+            time: 0.0,
+            step: 0,
+        }
+    }
+
+    /// Add a solid sphere of radius `r` and density `rho` at `pos` (wrapped into the box on
+    /// periodic axes) moving at `vel`, spinning at `omega`; returns its index.
+    pub fn add_sphere(
+        &mut self,
+        pos: Vec3,
+        vel: Vec3,
+        omega: Vec3,
+        r: f64,
+        rho: f64,
+    ) -> Result<usize, SphereError> {
+        if !(r > 0.0 && r.is_finite()) {
+            return Err(SphereError::BadParameter {
+                name: "sphere radius",
+                value: r,
+                why: "it must be positive and finite (m)",
+            });
+        }
+        if !(rho > 0.0 && rho.is_finite()) {
+            return Err(SphereError::BadParameter {
+                name: "sphere density",
+                value: rho,
+                why: "it must be positive and finite (kg/m^3)",
+            });
+        }
+        let s = &mut self.spheres;
+        if ![pos, vel, omega].iter().all(|v| v.is_finite()) {
+            return Err(SphereError::NonFinite {
+                sphere: s.len(),
+                step: self.step,
+            });
+        }
+        let m = rho * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+        s.pos.push(self.domain.wrap(pos));
+        s.vel.push(vel);
+        s.omega.push(omega);
+        s.force.push(Vec3::ZERO);
+        s.torque.push(Vec3::ZERO);
+        s.radius.push(r);
+        s.mass.push(m);
+        s.inertia.push(0.4 * m * r * r);
+        Ok(s.len() - 1)
+    }
+
+    /// Translational plus rotational kinetic energy (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        let s = &self.spheres;
+        (0..s.len())
+            .map(|k| 0.5 * s.mass[k] * s.vel[k].norm2() + 0.5 * s.inertia[k] * s.omega[k].norm2())
+            .sum()
+    }
+
+    /// Total linear momentum (kg m/s).
+    pub fn momentum(&self) -> Vec3 {
+        let s = &self.spheres;
+        (0..s.len()).fold(Vec3::ZERO, |acc, k| acc + s.vel[k] * s.mass[k])
+    }
+}
