@@ -346,7 +346,7 @@ fn oblique(m: &Material, law: &HertzMindlin, r: f64, speed: f64, angle_deg: f64)
     let th = angle_deg * PI / 180.0;
     let v = Vec3::new(speed * th.sin(), 0.0, -speed * th.cos());
     let (i, _) = sphere_on_plane(m, law, r, v, 2000.0);
-    let vc = i.vel.x - i.omega.y * r;
+    let vc = i.vel.x - i.omega.y * r; // the paper's rigid-body contact-point velocity
     (
         i.vel.x / v.x,
         i.omega.y,
@@ -426,11 +426,11 @@ fn test4_oblique_impact_matches_the_paper_and_the_sliding_limit() {
         d_reb = d_reb.max((reb - want).abs());
     }
     println!("Test 4 largest deviations: e_t {d_et:.4}, omega {d_om:.1} rad/s, rebound {d_reb:.2} deg");
-    // Measured: e_t 0.0125 (at 5.2 deg, where the curve falls 0.05 per degree; 0.0023 above
-    // 30 deg), omega 8.8 rad/s of 617 (at 10 deg), rebound angle 1.18 deg (at 15 deg).
-    assert!(d_et < 0.025, "e_t off the paper by {d_et}");
-    assert!(d_om < 18.0, "omega off the paper by {d_om} rad/s");
-    assert!(d_reb < 2.4, "rebound angle off the paper by {d_reb} deg");
+    // Measured: e_t 0.0144 (at 5.2 deg, where the curve falls 0.05 per degree; 0.0023 above
+    // 30 deg), omega 8.1 rad/s of 617 (at 10 deg), rebound angle 1.13 deg (at 15 deg).
+    assert!(d_et < 0.029, "e_t off the paper by {d_et}");
+    assert!(d_om < 16.0, "omega off the paper by {d_om} rad/s");
+    assert!(d_reb < 2.3, "rebound angle off the paper by {d_reb} deg");
 
     // Gross sliding (rigid-body impulse): for tan θ > (7/2) μ (1 + e_n) the contact slides
     // throughout, the tangential impulse is μ times the normal one, and
@@ -448,9 +448,85 @@ fn test4_oblique_impact_matches_the_paper_and_the_sliding_limit() {
         "Test 4 gross sliding: e_t off by {:.1e}, omega off by {:.1e} (relative)",
         worst.0, worst.1
     );
-    // Measured: e_t 1.0e-5, omega 4.2e-5 (relative).
+    // Measured: e_t 1.0e-5; omega 1.2e-3 relative, below the rigid value because the friction
+    // acts at the contact point, R − δ/2 from the centre (δ_max/R ≤ 2.8e-3 here).
     assert!(
-        worst.0 < 2e-5 && worst.1 < 7e-5,
+        worst.0 < 2e-5 && worst.1 < 2.4e-3,
         "gross-sliding limit off by {worst:?}"
     );
+}
+
+/// Reference for the no-slip limit (μ → ∞) of an elastic oblique impact on a rigid plane:
+/// the model's own equations integrated by RK4 at 200 000 steps per contact, independently of
+/// the engine. State: overlap δ, its rate, the tangential spring u, the centre's tangential
+/// velocity v and spin ω (about the axis normal to the plane of incidence):
+/// m δ̈ = −(4/3) E* √R δ^{3/2}; F = −8 G* √(R δ) u; m v̇ = F; I ω̇ = −a F; u̇ = v − a ω, with the
+/// contact point a = R − δ/2 below the centre (as in the engine). Returns the contact-point
+/// tangential velocity v − ω R after separation over the one before impact: for full stick a
+/// function of ν alone (Maw, Barber & Fawcett 1976; k_t/k_n = 2(1−ν)/(2−ν)).
+fn no_slip_tangential_restitution(e_star: f64, g_star: f64, r: f64, m: f64, vn: f64, vt: f64) -> f64 {
+    let k = 4.0 / 3.0 * e_star * r.sqrt();
+    let inertia = 0.4 * m * r * r;
+    let h = hertz(e_star, r, m, vn).t_c / 200_000.0;
+    let rhs = |y: [f64; 5]| -> [f64; 5] {
+        let d = y[0].max(0.0);
+        let a = r - 0.5 * d;
+        let f = -8.0 * g_star * (r * d).sqrt() * y[2];
+        [
+            y[1],
+            -k / m * d * d.sqrt(),
+            y[3] - a * y[4],
+            f / m,
+            -a * f / inertia,
+        ]
+    };
+    let mut y = [0.0, vn, 0.0, vt, 0.0];
+    loop {
+        let add = |y: [f64; 5], k: [f64; 5], s: f64| -> [f64; 5] { std::array::from_fn(|i| y[i] + s * k[i]) };
+        let k1 = rhs(y);
+        let k2 = rhs(add(y, k1, 0.5 * h));
+        let k3 = rhs(add(y, k2, 0.5 * h));
+        let k4 = rhs(add(y, k3, h));
+        let next: [f64; 5] =
+            std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+        if next[0] <= 0.0 {
+            // Past separation the state no longer changes but for δ: take it at the step's end.
+            return (next[3] - next[4] * r) / vt;
+        }
+        y = next;
+    }
+}
+
+/// Test 4, small-angle (sticking) limit: with friction too large to slide, the contact-point
+/// tangential velocity is reversed by the Mindlin spring alone; the engine's history carried
+/// across the whole contact must give the restitution of the RK4 reference above.
+#[test]
+fn test4_no_slip_limit_matches_an_independent_integration() {
+    for m in [&ALUMINA, &AL_ALLOY_T4] {
+        let law = m.law(1e6, 1.0);
+        let r = 0.0025;
+        let c = law.wall_coeffs();
+        let mass = m.rho * 4.0 / 3.0 * PI * r * r * r;
+        for a in [5.0, 30.0] {
+            let th = f64::to_radians(a);
+            let v = Vec3::new(3.9 * th.sin(), 0.0, -3.9 * th.cos());
+            let want = no_slip_tangential_restitution(c.e_star, c.g_star, r, mass, -v.z, v.x);
+            let mut err = [0.0; 2];
+            for (e, n) in err.iter_mut().zip([2000.0, 16000.0]) {
+                let (i, _) = sphere_on_plane(m, &law, r, v, n);
+                // Contact-point velocity (arm R: the contact is open again).
+                let beta = (i.vel.x - i.omega.y * r) / v.x;
+                println!(
+                    "no-slip {} at {a} deg, {n} steps per contact: v_c'/v_c = {beta:.7}, RK4 {want:.7}",
+                    m.name
+                );
+                *e = (beta - want).abs();
+            }
+            // Measured: at most 1.12e-3 off at 2000 steps per contact, 2.2e-4 at 16 000 (the
+            // engine converges to the reference at about first order in dt, the √δ stiffness
+            // being singular where the contact opens and closes; error ratios 5.1-19.6).
+            assert!(err[0] < 2.3e-3 && err[1] < 4.4e-4, "{}: errors {err:?}", m.name);
+            assert!(err[1] < err[0] / 3.0, "{}: no convergence {err:?}", m.name);
+        }
+    }
 }

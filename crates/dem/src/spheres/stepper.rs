@@ -200,11 +200,15 @@ impl SphereStepper {
             }
             let dist = dist2.sqrt();
             let nrm = d * (1.0 / dist);
-            let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ri)) - (s.vel[j] + s.omega[j].cross(nrm * -rj));
+            let delta = rs - dist;
+            // Arms to the contact point, halfway into the overlap (a_i + a_j = distance, so the
+            // pair conserves angular momentum).
+            let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
+            let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (s.vel[j] + s.omega[j].cross(nrm * -aj));
             let (mi, mj) = (s.mass[i], s.mass[j]);
             let kin = ContactKin {
                 n: nrm,
-                delta: rs - dist,
+                delta,
                 r_eff: ri * rj / rs,
                 m_eff: mi * mj / (mi + mj),
                 v_rel,
@@ -213,8 +217,8 @@ impl SphereStepper {
             s.force[i] += f;
             s.force[j] -= f;
             let tq = nrm.cross(f);
-            s.torque[i] += tq * ri;
-            s.torque[j] += tq * rj;
+            s.torque[i] += tq * ai;
+            s.torque[j] += tq * aj;
         }
         let nw = sys.walls.len();
         if nw > 0 {
@@ -229,17 +233,19 @@ impl SphereStepper {
                         continue;
                     }
                     let nrm = -wall.normal;
-                    let v_rel = s.vel[k] + s.omega[k].cross(nrm * r) - wall.vel;
+                    let delta = r - gap;
+                    let a = r - 0.5 * delta;
+                    let v_rel = s.vel[k] + s.omega[k].cross(nrm * a) - wall.vel;
                     let kin = ContactKin {
                         n: nrm,
-                        delta: r - gap,
+                        delta,
                         r_eff: r,
                         m_eff: s.mass[k],
                         v_rel,
                     };
                     let (f, _) = hertz_mindlin_force(&wc, &kin, p.dt, xi);
                     s.force[k] += f;
-                    s.torque[k] += nrm.cross(f) * r;
+                    s.torque[k] += nrm.cross(f) * a;
                 }
             }
         }
