@@ -332,11 +332,13 @@ fn test3_restitution_is_recovered() {
         st.step(&p, &law, &mut sys).unwrap();
     }
     let v = sys.spheres.vel[0].z;
-    // Measured |v| = 2e-3 m/s after 20 us (5 contact times), still in contact.
-    assert!(
-        v.abs() < 0.02 * 3.9 && sys.spheres.pos[0].z < 0.0025,
-        "e = 0: v {v}"
+    println!(
+        "Test 3 e = 0: v = {v:.2e} m/s, z - R = {:.2e} m",
+        sys.spheres.pos[0].z - 0.0025
     );
+    // Measured v = 2.1e-2 m/s (0.55 % of the impact speed) after 20 us (about 3 elastic
+    // contact times), the overlap relaxing without a bounce, still in contact.
+    assert!(v.abs() < 0.043 && sys.spheres.pos[0].z < 0.0025, "e = 0: v {v}");
 }
 
 /// An oblique impact on the rigid plane z = 0: speed `speed` at `angle_deg` from the normal.
