@@ -5,6 +5,7 @@
 
 use super::domain::Domain3;
 use super::error::SphereError;
+use super::system::FREE;
 use crate::vector::{Vec3, Vector};
 
 const MAX_CELLS: usize = 64 << 20;
@@ -21,12 +22,14 @@ pub struct CellList3 {
 
 impl CellList3 {
     /// Pairs (i < j, sorted) of spheres closer than r_i + r_j + skin (centre distance, minimum
-    /// image on periodic axes).
+    /// image on periodic axes), leaving out pairs of the same clump (`owner`, [`FREE`] for a
+    /// free sphere; an empty slice: every sphere free).
     pub fn build_pairs(
         &mut self,
         dom: &Domain3,
         pos: &[Vec3],
         r: &[f64],
+        owner: &[u32],
         skin: f64,
     ) -> Result<Vec<[u32; 2]>, SphereError> {
         let n = pos.len();
@@ -117,7 +120,7 @@ impl CellList3 {
                         let cc = (z * nc[1] + y) * nc[0] + x;
                         let range = self.cell_start[cc] as usize..self.cell_start[cc + 1] as usize;
                         for &j in &self.sorted[range] {
-                            if (j as usize) <= i {
+                            if (j as usize) <= i || same_clump(owner, i, j as usize) {
                                 continue;
                             }
                             let d = dom.min_image(pos[j as usize] - pi);
@@ -136,11 +139,20 @@ impl CellList3 {
     }
 }
 
+/// True if spheres `i` and `j` are members of the same clump.
+#[inline]
+fn same_clump(owner: &[u32], i: usize, j: usize) -> bool {
+    !owner.is_empty() && owner[i] != FREE && owner[i] == owner[j]
+}
+
 /// Brute-force reference (all pairs), for tests of the cell list.
-pub fn brute_force_pairs(dom: &Domain3, pos: &[Vec3], r: &[f64], skin: f64) -> Vec<[u32; 2]> {
+pub fn brute_force_pairs(dom: &Domain3, pos: &[Vec3], r: &[f64], owner: &[u32], skin: f64) -> Vec<[u32; 2]> {
     let mut out = Vec::new();
     for i in 0..pos.len() {
         for j in i + 1..pos.len() {
+            if same_clump(owner, i, j) {
+                continue;
+            }
             let rc = r[i] + r[j] + skin;
             if dom.min_image(pos[j] - pos[i]).norm2() < rc * rc {
                 out.push([i as u32, j as u32]);
@@ -174,14 +186,27 @@ mod tests {
         for mask in 0..8u8 {
             let periodic = [mask & 1 != 0, mask & 2 != 0, mask & 4 != 0];
             let dom = Domain3::new(Vec3::ZERO, hi, periodic).unwrap();
-            let got = cl.build_pairs(&dom, &pos, &r, 0.01).unwrap();
-            let want = brute_force_pairs(&dom, &pos, &r, 0.01);
+            let got = cl.build_pairs(&dom, &pos, &r, &[], 0.01).unwrap();
+            let want = brute_force_pairs(&dom, &pos, &r, &[], 0.01);
             assert!(!want.is_empty());
             assert_eq!(got, want, "periodic {periodic:?}");
+            // Spheres grouped in threes into clumps (every fourth one free): no pair inside a
+            // clump, the others as before.
+            let owner: Vec<u32> = (0..600u32)
+                .map(|k| if k % 4 == 3 { FREE } else { k / 12 })
+                .collect();
+            let got = cl.build_pairs(&dom, &pos, &r, &owner, 0.01).unwrap();
+            let want_c = brute_force_pairs(&dom, &pos, &r, &owner, 0.01);
+            assert_eq!(got, want_c, "periodic {periodic:?}, clumps");
+            let inside = want
+                .iter()
+                .filter(|p| owner[p[0] as usize] != FREE && owner[p[0] as usize] == owner[p[1] as usize])
+                .count();
+            assert!(inside > 0 && want_c.len() + inside == want.len());
         }
         // An axis too short for a unique minimum image is refused.
         let dom = Domain3::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.2), [false, false, true]).unwrap();
-        let err = cl.build_pairs(&dom, &pos, &r, 0.01).unwrap_err();
+        let err = cl.build_pairs(&dom, &pos, &r, &[], 0.01).unwrap_err();
         assert!(
             matches!(err, SphereError::PeriodicBoxTooSmall { axis: 2, .. }),
             "{err}"

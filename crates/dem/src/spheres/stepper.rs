@@ -10,9 +10,10 @@
 //! and continues bit for bit.
 
 use super::cells::CellList3;
+use super::clump::{Clumps, free_rotation, from_na, quat_array, to_na};
 use super::error::SphereError;
 use super::law::{ContactKin, HertzMindlin, hertz_mindlin_force};
-use super::system::SphereSystem;
+use super::system::{FREE, SphereSystem, Spheres};
 use crate::neighbor::carry_history_into;
 use crate::vector::{Vec3, Vector};
 use serde::{Deserialize, Serialize};
@@ -110,25 +111,45 @@ impl SphereStepper {
         let dt = p.dt;
         let h = 0.5 * dt;
         let dom = sys.domain;
-        let s = &mut sys.spheres;
-        let n = s.len();
-        // Opening half kick and drift.
+        let n = sys.spheres.len();
+        // Opening half kick and drift: free spheres, then clumps (members placed on them).
         for k in 0..n {
-            s.vel[k] += s.force[k] * (h / s.mass[k]);
-            s.omega[k] += s.torque[k] * (h / s.inertia[k]);
-            s.pos[k] = dom.wrap(s.pos[k] + s.vel[k] * dt);
+            if sys.is_free(k) {
+                let s = &mut sys.spheres;
+                s.vel[k] += s.force[k] * (h / s.mass[k]);
+                s.omega[k] += s.torque[k] * (h / s.inertia[k]);
+                s.pos[k] = dom.wrap(s.pos[k] + s.vel[k] * dt);
+            }
         }
+        let c = &mut sys.clumps;
+        for k in 0..c.len() {
+            c.vel[k] += c.force[k] * (h / c.mass[k]);
+            c.ang_mom[k] += c.torque[k] * h;
+            c.pos[k] = dom.wrap(c.pos[k] + c.vel[k] * dt);
+            let q = free_rotation(c.orientation(k), c.ang_mom[k], c.inertia[k], dt);
+            c.quat[k] = quat_array(&q);
+        }
+        place_members(sys, true);
         for w in &mut sys.walls {
             w.point += w.vel * dt;
         }
         self.refresh_list(p.skin, sys)?;
         self.forces(p, law, sys);
+        gather_clumps(sys, p.gravity);
         // Closing half kick.
-        let s = &mut sys.spheres;
         for k in 0..n {
-            s.vel[k] += s.force[k] * (h / s.mass[k]);
-            s.omega[k] += s.torque[k] * (h / s.inertia[k]);
+            if sys.is_free(k) {
+                let s = &mut sys.spheres;
+                s.vel[k] += s.force[k] * (h / s.mass[k]);
+                s.omega[k] += s.torque[k] * (h / s.inertia[k]);
+            }
         }
+        let c = &mut sys.clumps;
+        for k in 0..c.len() {
+            c.vel[k] += c.force[k] * (h / c.mass[k]);
+            c.ang_mom[k] += c.torque[k] * h;
+        }
+        place_members(sys, false);
         sys.time += dt;
         sys.step += 1;
         let s = &sys.spheres;
@@ -158,7 +179,7 @@ impl SphereStepper {
                 .all(|(&p, &q)| dom.min_image(p - q).norm2() <= lim)
         };
         if !fresh {
-            let pairs = self.cells.build_pairs(&dom, &s.pos, &s.radius, skin)?;
+            let pairs = self.cells.build_pairs(&dom, &s.pos, &s.radius, &s.owner, skin)?;
             self.new_xi.clear();
             self.new_xi.resize(pairs.len(), Vec3::ZERO);
             let keep = c.pairs.len().min(c.xi.len());
@@ -182,6 +203,7 @@ impl SphereStepper {
         let dom = sys.domain;
         let s = &mut sys.spheres;
         let c = &mut sys.contacts;
+        let cl = &sys.clumps;
         let n = s.len();
         for k in 0..n {
             s.force[k] = Vec3::ZERO;
@@ -205,7 +227,7 @@ impl SphereStepper {
             // pair conserves angular momentum).
             let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
             let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (s.vel[j] + s.omega[j].cross(nrm * -aj));
-            let (mi, mj) = (s.mass[i], s.mass[j]);
+            let (mi, mj) = (body_mass(s, cl, i), body_mass(s, cl, j));
             let kin = ContactKin {
                 n: nrm,
                 delta,
@@ -240,7 +262,7 @@ impl SphereStepper {
                         n: nrm,
                         delta,
                         r_eff: r,
-                        m_eff: s.mass[k],
+                        m_eff: body_mass(s, cl, k),
                         v_rel,
                     };
                     let (f, _) = hertz_mindlin_force(&wc, &kin, p.dt, xi);
@@ -251,8 +273,57 @@ impl SphereStepper {
         }
         if p.gravity != Vec3::ZERO {
             for k in 0..n {
-                s.force[k] += p.gravity * s.mass[k];
+                if s.owner.get(k).is_none_or(|&o| o == FREE) {
+                    s.force[k] += p.gravity * s.mass[k];
+                }
             }
         }
+    }
+}
+
+/// The mass that moves with sphere `k`: its own, or its clump's.
+#[inline]
+fn body_mass(s: &Spheres, cl: &Clumps, k: usize) -> f64 {
+    match s.owner.get(k) {
+        Some(&o) if o != FREE => cl.mass[o as usize],
+        _ => s.mass[k],
+    }
+}
+
+/// Place each clump's members on it: velocities and spins always, positions if `positions`
+/// (x_s = x_c + Q b_s, v_s = v_c + ω × Q b_s, ω_s = ω).
+fn place_members(sys: &mut SphereSystem, positions: bool) {
+    let dom = sys.domain;
+    let (c, s) = (&sys.clumps, &mut sys.spheres);
+    for k in 0..c.len() {
+        let q = c.orientation(k);
+        let w = c.omega(k);
+        for (m, b) in c.members_of(k) {
+            let arm = from_na(q.transform_vector(&to_na(b)));
+            if positions {
+                s.pos[m] = dom.wrap(c.pos[k] + arm);
+            }
+            s.vel[m] = c.vel[k] + w.cross(arm);
+            s.omega[m] = w;
+        }
+    }
+}
+
+/// Each clump's force and torque about its centre of mass: its members' contact forces (in
+/// member order) and gravity on its mass.
+fn gather_clumps(sys: &mut SphereSystem, gravity: Vec3) {
+    let (c, s) = (&mut sys.clumps, &sys.spheres);
+    for k in 0..c.len() {
+        let q = c.orientation(k);
+        let (mut f, mut t) = (Vec3::ZERO, Vec3::ZERO);
+        let r = c.start[k] as usize..c.start[k + 1] as usize;
+        for (&m, &b) in c.members[r.clone()].iter().zip(&c.offset[r]) {
+            let m = m as usize;
+            let arm = from_na(q.transform_vector(&to_na(b)));
+            f += s.force[m];
+            t += arm.cross(s.force[m]) + s.torque[m];
+        }
+        c.force[k] = f + gravity * c.mass[k];
+        c.torque[k] = t;
     }
 }

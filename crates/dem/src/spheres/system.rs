@@ -4,9 +4,11 @@
 //! quantity the step reads — the last forces, the pair list and the positions it was built at —
 //! is here, and the stepper holds only scratch.
 
+use super::clump::{BodyFrame, ClumpTemplate, Clumps, from_na, quat_array, to_na};
 use super::domain::Domain3;
 use super::error::SphereError;
 use crate::vector::{Vec3, Vector};
+use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
 
 /// The spheres, one entry per sphere in every array (structure of arrays).
@@ -24,7 +26,13 @@ pub struct Spheres {
     pub mass: Vec<f64>,
     /// Moment of inertia about the centre, (2/5) m r² for a solid sphere.
     pub inertia: Vec<f64>,
+    /// The clump a sphere belongs to, or [`FREE`].
+    #[serde(default)]
+    pub owner: Vec<u32>,
 }
+
+/// `owner` of a sphere that belongs to no clump.
+pub const FREE: u32 = u32::MAX;
 
 impl Spheres {
     pub fn len(&self) -> usize {
@@ -87,6 +95,9 @@ pub struct SphereSystem {
     pub spheres: Spheres,
     pub walls: Vec<PlaneWall>,
     pub contacts: SphereContacts,
+    /// Rigid clumps of spheres (their members are in `spheres`).
+    #[serde(default)]
+    pub clumps: Clumps,
     /// Simulated time (s).
     pub time: f64,
     /// Steps taken.
@@ -100,6 +111,7 @@ impl SphereSystem {
             spheres: Spheres::default(),
             walls: Vec::new(),
             contacts: SphereContacts::default(),
+            clumps: Clumps::default(),
             time: 0.0,
             step: 0,
         }
@@ -145,20 +157,112 @@ impl SphereSystem {
         s.radius.push(r);
         s.mass.push(m);
         s.inertia.push(0.4 * m * r * r);
+        s.owner.push(FREE);
         Ok(s.len() - 1)
     }
 
-    /// Translational plus rotational kinetic energy (J).
-    pub fn kinetic_energy(&self) -> f64 {
-        let s = &self.spheres;
-        (0..s.len())
-            .map(|k| 0.5 * s.mass[k] * s.vel[k].norm2() + 0.5 * s.inertia[k] * s.omega[k].norm2())
-            .sum()
+    /// Add a rigid clump of `template`'s spheres (density `rho`, mass properties of their union
+    /// by [`ClumpTemplate::union_props`] with `nodes` per piece, e.g.
+    /// [`super::clump::DEFAULT_NODES`]), its centre of mass at
+    /// `pos`, turned by `orientation` from the template's frame, moving at `vel`, spinning at
+    /// `omega`; returns the clump's index.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_clump(
+        &mut self,
+        template: &ClumpTemplate,
+        pos: Vec3,
+        orientation: UnitQuaternion<f64>,
+        vel: Vec3,
+        omega: Vec3,
+        rho: f64,
+        nodes: usize,
+    ) -> Result<usize, SphereError> {
+        if !(rho > 0.0 && rho.is_finite()) {
+            return Err(SphereError::BadParameter {
+                name: "clump density",
+                value: rho,
+                why: "it must be positive and finite (kg/m^3)",
+            });
+        }
+        if ![pos, vel, omega].iter().all(|v| v.is_finite()) {
+            return Err(SphereError::NonFinite {
+                sphere: self.spheres.len(),
+                step: self.step,
+            });
+        }
+        let frame = BodyFrame::of(template, rho, nodes)?;
+        let q = orientation * frame.to_template;
+        let c = self.clumps.len();
+        let first = self.spheres.len();
+        for (k, (&b, &(_, r))) in frame.offsets.iter().zip(&template.spheres).enumerate() {
+            let arm = from_na(q.transform_vector(&to_na(b)));
+            self.add_sphere(pos + arm, vel + omega.cross(arm), omega, r, rho)?;
+            self.spheres.owner[first + k] = c as u32;
+        }
+        let cl = &mut self.clumps;
+        if cl.start.is_empty() {
+            cl.start.push(0);
+        }
+        cl.members.extend((first..self.spheres.len()).map(|k| k as u32));
+        cl.offset.extend_from_slice(&frame.offsets);
+        cl.start.push(cl.members.len() as u32);
+        let i = frame.inertia;
+        // L = Q I Qᵀ ω.
+        let wb = q.inverse_transform_vector(&to_na(omega));
+        let l = from_na(q.transform_vector(&nalgebra::Vector3::new(i.x * wb.x, i.y * wb.y, i.z * wb.z)));
+        cl.pos.push(self.domain.wrap(pos));
+        cl.vel.push(vel);
+        cl.quat.push(quat_array(&q));
+        cl.ang_mom.push(l);
+        cl.mass.push(frame.mass);
+        cl.inertia.push(i);
+        cl.force.push(Vec3::ZERO);
+        cl.torque.push(Vec3::ZERO);
+        Ok(c)
     }
 
-    /// Total linear momentum (kg m/s).
+    /// True if sphere `k` moves by itself (belongs to no clump).
+    #[inline]
+    pub fn is_free(&self, k: usize) -> bool {
+        self.spheres.owner.get(k).is_none_or(|&o| o == FREE)
+    }
+
+    /// Translational plus rotational kinetic energy of free spheres and clumps (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        let s = &self.spheres;
+        let free: f64 = (0..s.len())
+            .filter(|&k| self.is_free(k))
+            .map(|k| 0.5 * s.mass[k] * s.vel[k].norm2() + 0.5 * s.inertia[k] * s.omega[k].norm2())
+            .sum();
+        let c = &self.clumps;
+        let clumps: f64 = (0..c.len())
+            .map(|k| 0.5 * c.mass[k] * c.vel[k].norm2() + c.rotational_energy(k))
+            .sum();
+        free + clumps
+    }
+
+    /// Total linear momentum of free spheres and clumps (kg m/s).
     pub fn momentum(&self) -> Vec3 {
         let s = &self.spheres;
-        (0..s.len()).fold(Vec3::ZERO, |acc, k| acc + s.vel[k] * s.mass[k])
+        let c = &self.clumps;
+        let free = (0..s.len())
+            .filter(|&k| self.is_free(k))
+            .fold(Vec3::ZERO, |acc, k| acc + s.vel[k] * s.mass[k]);
+        (0..c.len()).fold(free, |acc, k| acc + c.vel[k] * c.mass[k])
+    }
+
+    /// Total angular momentum about the origin (kg m²/s): x × m v + I ω of free spheres,
+    /// x_c × m v_c + L of clumps (positions as stored, so only meaningful without periodic wrap).
+    pub fn angular_momentum(&self) -> Vec3 {
+        let s = &self.spheres;
+        let c = &self.clumps;
+        let free = (0..s.len())
+            .filter(|&k| self.is_free(k))
+            .fold(Vec3::ZERO, |acc, k| {
+                acc + s.pos[k].cross(s.vel[k] * s.mass[k]) + s.omega[k] * s.inertia[k]
+            });
+        (0..c.len()).fold(free, |acc, k| {
+            acc + c.pos[k].cross(c.vel[k] * c.mass[k]) + c.ang_mom[k]
+        })
     }
 }
