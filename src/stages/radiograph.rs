@@ -11,6 +11,7 @@ use crate::io::tiff as tio;
 use crate::report::{plot, table};
 use anyhow::{Context, Result, bail};
 use lbdem_imaging::beer_lambert::{self as bl, FractionMap};
+use lbdem_imaging::edge::{self, BulkPhase};
 use lbdem_imaging::profile::{self, ProfileAxis};
 use lbdem_imaging::rev::{self, Sat};
 use lbdem_imaging::{Roi, correct};
@@ -67,6 +68,36 @@ pub struct LineScan {
     /// Liquid-air interfacial energy, J/m^2 (Su et al. 2020 take 0.7 for Al-Cu, ref. [123]).
     #[serde(default = "gamma_alcu")]
     pub gamma: f64,
+}
+
+/// Flagging the REVs that reach a bulk phase (`lbdem_imaging::edge`): a liquid gap, a
+/// container wall, a solid pad, where eps_vol is less accurate than inside the assembly.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EdgeFlag {
+    /// Write the flags (`near_edge_NNN.tif`, grid and profile columns, summary figures).
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// Side of the window that decides "bulk", in units of `d_bar` (two grains: liquid pockets
+    /// of one grain inside a packing are not bulk).
+    #[serde(default = "two")]
+    pub window_d: f64,
+    /// Window-mean pixel g_S below which a pixel is bulk liquid, above which bulk solid.
+    #[serde(default = "bulk_liquid")]
+    pub liquid_below: f64,
+    #[serde(default = "bulk_solid")]
+    pub solid_above: f64,
+}
+
+impl Default for EdgeFlag {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            window_d: 2.0,
+            liquid_below: bulk_liquid(),
+            solid_above: bulk_solid(),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -135,6 +166,9 @@ pub struct Params {
     /// Also write per-pixel fields (corrected intensity, pixel `L_S/L`).
     #[serde(default)]
     pub write_pixel_maps: bool,
+    /// REVs near a bulk phase, flagged in the outputs (on by default).
+    #[serde(default)]
+    pub edge_flag: EdgeFlag,
 }
 
 fn three() -> usize {
@@ -154,6 +188,15 @@ fn eps_min_gs() -> f64 {
 }
 fn half() -> f64 {
     0.5
+}
+fn two() -> f64 {
+    2.0
+}
+fn bulk_liquid() -> f64 {
+    0.05
+}
+fn bulk_solid() -> f64 {
+    0.95
 }
 fn yes() -> bool {
     true
@@ -193,6 +236,8 @@ pub struct Prepared {
     pub dose: Vec<f64>,
     pub masked: Vec<usize>,
     pub warnings: Vec<String>,
+    /// The bulk-phase rule of `edge_flag`, if enabled.
+    pub bulk: Option<BulkPhase>,
 }
 
 fn positive(name: &str, v: f64) -> Result<()> {
@@ -237,6 +282,18 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
     }
     one_of("i_l0", p.i_l0, p.i_l0_roi)?;
     one_of("i_s0", p.i_s0, p.i_s0_roi)?;
+    let bulk = if p.edge_flag.enabled {
+        positive("edge_flag.window_d", p.edge_flag.window_d)?;
+        let rule = BulkPhase {
+            window_px: ((p.edge_flag.window_d * p.d_bar / p.pixel_size).round() as usize).max(1),
+            liquid_below: p.edge_flag.liquid_below,
+            solid_above: p.edge_flag.solid_above,
+        };
+        rule.validate()?;
+        Some(rule)
+    } else {
+        None
+    };
     if p.thickness != Thickness::None && p.thickness_roi.is_none() {
         bail!(
             "thickness = \"{:?}\" needs 'thickness_roi' = [x, y, w, h]",
@@ -424,6 +481,7 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
         dose,
         masked,
         warnings,
+        bulk,
     })
 }
 
@@ -437,13 +495,22 @@ fn finite_mean(a: &Array2<f64>) -> f64 {
 }
 
 /// One profile of one frame: positions (px), REV g_S, and eps_vol (frames n >= 1).
-type ProfileOut = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
+/// Position, g_S, eps_vol and the fraction of the ROI's REVs flagged near a bulk phase.
+type ProfileOut = (Vec<f64>, Vec<f64>, Option<Vec<f64>>, Option<Vec<f64>>);
 
 /// Per-frame results kept for the tables.
 struct FrameOut {
     gs_tiles: Array2<f64>,
     eps_tiles: Option<Array2<f64>>,
+    /// Tiles holding a bulk-phase pixel of frame 0 or this frame (eps frames only).
+    edge_tiles: Option<Array2<f64>>,
     profiles: Vec<ProfileOut>,
+}
+
+/// A map waiting to be written: a field (32-bit float TIFF) or a flag (8-bit).
+enum Map {
+    F32(Array2<f64>),
+    U8(Array2<u8>),
 }
 
 /// The float maps encoded and written on a second thread while the next frame is computed:
@@ -451,16 +518,19 @@ struct FrameOut {
 /// wait; dropping the writer (an error in the loop) waits for the maps already sent, so nothing
 /// is written into the stage's directory after the stage returned.
 struct MapWriter {
-    tx: Option<std::sync::mpsc::SyncSender<(PathBuf, Array2<f64>)>>,
+    tx: Option<std::sync::mpsc::SyncSender<(PathBuf, Map)>>,
     handle: Option<std::thread::JoinHandle<Result<()>>>,
 }
 
 impl MapWriter {
     fn new() -> Self {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<(PathBuf, Array2<f64>)>(2);
+        let (tx, rx) = std::sync::mpsc::sync_channel::<(PathBuf, Map)>(2);
         let handle = std::thread::spawn(move || {
             for (path, map) in rx {
-                tio::write_f32(&path, map.view())?;
+                match map {
+                    Map::F32(m) => tio::write_f32(&path, m.view())?,
+                    Map::U8(m) => tio::write_u8(&path, m.view())?,
+                }
             }
             Ok(())
         });
@@ -471,6 +541,15 @@ impl MapWriter {
     }
 
     fn write(&mut self, path: PathBuf, map: Array2<f64>) -> Result<()> {
+        self.send(path, Map::F32(map))
+    }
+
+    /// A 0/1 flag map, as 8-bit (a quarter of the bytes of a float map).
+    fn write_u8(&mut self, path: PathBuf, map: Array2<u8>) -> Result<()> {
+        self.send(path, Map::U8(map))
+    }
+
+    fn send(&mut self, path: PathBuf, map: Map) -> Result<()> {
         let sent = self.tx.as_ref().is_some_and(|tx| tx.send((path, map)).is_ok());
         if sent { Ok(()) } else { self.finish() }
     }
@@ -511,6 +590,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
     let mut frames_json = Vec::new();
     let mut outs = Vec::new();
     let mut maps = MapWriter::new();
+    let mut flagger = pr.bulk.map(|b| edge::Flagger::new(b, pr.rev_side)).transpose()?;
     for n in 0..nf {
         let gpix = pr.maps[n].field(pr.intensity[n].view());
         sat.build(gpix.view());
@@ -529,7 +609,15 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
                 files.push(fname.into());
             }
         }
+        if let Some(f) = flagger.as_mut() {
+            f.frame(&sat)?;
+        }
+        let near = flagger.as_ref().filter(|_| n > 0).map(|f| f.near_u8());
+        let near = near.as_ref();
         let mut eps_json = serde_json::Value::Null;
+        let mut eps_away_json = serde_json::Value::Null;
+        let mut near_json = serde_json::Value::Null;
+        let mut edge_tiles = None;
         let mut eps_tiles = None;
         let eps = (n > 0).then(|| bl::eps_vol_field(g0_rev.view(), g_rev.view(), p.eps_min_gs));
         if let Some(eps) = &eps {
@@ -537,6 +625,25 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
             maps.write(out.join(format!("{ename}.tif")), eps.clone())?;
             files.push(format!("{ename}.tif").into());
             eps_json = json!(finite_mean(eps));
+            if let (Some(near), Some(flagger)) = (near, &flagger) {
+                let fname = format!("near_edge_{n:03}.tif");
+                maps.write_u8(out.join(&fname), near.clone())?;
+                files.push(fname.into());
+                let (mut k, mut kn, mut sum) = (0usize, 0usize, 0.0);
+                for (&e, &f) in eps.iter().zip(near) {
+                    if e.is_finite() {
+                        k += 1;
+                        if f > 0 {
+                            kn += 1;
+                        } else {
+                            sum += e;
+                        }
+                    }
+                }
+                near_json = json!(if k > 0 { kn as f64 / k as f64 } else { f64::NAN });
+                eps_away_json = json!(if k > kn { sum / (k - kn) as f64 } else { f64::NAN });
+                edge_tiles = Some(flagger.tiles());
+            }
             let g0t = outs
                 .first()
                 .map(|o: &FrameOut| o.gs_tiles.clone())
@@ -596,7 +703,18 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
                 Some(e) => Some(profile::roi_profile(e.view(), spec.roi, spec.axis, "profiles.roi")?.1),
                 None => None,
             };
-            profs.push((pos, g, e));
+            // The flag's share across the ROI: the profile of the ROI's flags alone.
+            let f = match near {
+                Some(f) => {
+                    spec.roi.check("profiles.roi", f.dim())?;
+                    let r = spec.roi;
+                    let sub = f.slice(s![r.y..r.y + r.h, r.x..r.x + r.w]).mapv(f64::from);
+                    let whole = Roi::new(0, 0, spec.roi.w, spec.roi.h);
+                    Some(profile::roi_profile(sub.view(), whole, spec.axis, "profiles.roi")?.1)
+                }
+                None => None,
+            };
+            profs.push((pos, g, e, f));
         }
         frames_json.push(json!({
             "frame": n,
@@ -606,6 +724,8 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
             "g_s_global": global,
             "g_s_rev_mean": finite_mean(gmap),
             "eps_vol_mean": eps_json,
+            "near_edge_fraction": near_json,
+            "eps_vol_mean_away_from_edges": eps_away_json,
             "dose_divisor": pr.dose[n],
             "gamma_spots_replaced": pr.gamma_replaced[n],
             "masked_pixels": pr.masked[n],
@@ -613,6 +733,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         outs.push(FrameOut {
             gs_tiles,
             eps_tiles,
+            edge_tiles,
             profiles: profs,
         });
         pb.inc(1);
@@ -638,13 +759,17 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         if let Some(e) = &o.eps_tiles {
             cols.push((format!("eps_vol_{n:03}"), e.iter().copied().collect()));
         }
+        if let Some(t) = &o.edge_tiles {
+            cols.push((format!("near_edge_{n:03}"), t.iter().copied().collect()));
+        }
     }
     write_table(out, "grid.csv", &cols)?;
     files.push("grid.csv".into());
     tables.push(Table {
         path: "grid.csv".into(),
         caption: format!(
-            "Tiled REV grid ({th} x {tw} tiles of {} px): tile centres (mm), g_S of every frame and eps_vol (Eq. 5).",
+            "Tiled REV grid ({th} x {tw} tiles of {} px): tile centres (mm), g_S of every frame and eps_vol (Eq. 5); \
+             near_edge = 1 where the tile reaches a bulk liquid or solid region (eps_vol less accurate there, docs/radiograph.md).",
             pr.rev_side
         ),
     });
@@ -662,6 +787,9 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
             if let Some(e) = &o.profiles[k].2 {
                 cols.push((format!("eps_vol_{n:03}"), e.clone()));
             }
+            if let Some(f) = &o.profiles[k].3 {
+                cols.push((format!("near_edge_fraction_{n:03}"), f.clone()));
+            }
         }
         let name = format!("profile_{}.csv", spec.name);
         write_table(out, &name, &cols)?;
@@ -669,7 +797,8 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         tables.push(Table {
             path: name.into(),
             caption: format!(
-                "Profile '{}' along {axis} over ROI {:?} (px): REV g_S and eps_vol averaged across the ROI.",
+                "Profile '{}' along {axis} over ROI {:?} (px): REV g_S and eps_vol averaged across the ROI; \
+                 near_edge_fraction = share of those REVs flagged near a bulk phase.",
                 spec.name,
                 <[usize; 4]>::from(spec.roi)
             ),

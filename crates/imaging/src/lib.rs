@@ -8,6 +8,7 @@
 
 pub mod beer_lambert;
 pub mod correct;
+pub mod edge;
 pub mod error;
 pub mod profile;
 pub mod rev;
