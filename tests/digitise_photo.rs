@@ -66,13 +66,9 @@ fn check_photo(extra: &str) -> serde_json::Value {
     let n = s["n_grains"].as_u64().unwrap();
     assert_eq!(n, 29, "disks found");
     // Two size classes: split the equivalent diameters at their largest gap.
-    let csv = std::fs::read_to_string(dir.path().join("grains.csv")).unwrap();
-    let mut lines = csv.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = head.iter().position(|&h| h == "d_eq_m").unwrap();
-    let mut d: Vec<f64> = lines
-        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
-        .collect();
+    let path = dir.path().join("grains.csv");
+    let df = lbdem::report::table::read_table(&path).unwrap();
+    let mut d = lbdem::report::table::f64_column(&df, "d_eq_m", &path).unwrap();
     d.sort_by(f64::total_cmp);
     let (gap_at, gap) = (1..d.len())
         .map(|i| (i, d[i] - d[i - 1]))

@@ -59,18 +59,18 @@ fn cli_writes_the_assembly_with_its_header() {
     assert_eq!(header["pixel_size_m"].as_f64().unwrap(), px);
     assert!(header["axes"].as_str().unwrap().contains("y up"));
     let csv = std::fs::read_to_string(out.join("particles.csv")).unwrap();
-    let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("grain_id,x,y,r"));
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
-    let n_grains = rows.iter().map(|r| r[0] as usize).max().unwrap();
+    assert_eq!(csv.lines().next(), Some("grain_id,x,y,r"));
+    let path = out.join("particles.csv");
+    let df = lbdem::report::table::read_table(&path).unwrap();
+    let col = |n: &str| lbdem::report::table::f64_column(&df, n, &path).unwrap();
+    let (ids, ys) = (col("grain_id"), col("y"));
+    let n_grains = ids.iter().map(|&i| i as usize).max().unwrap();
     assert_eq!(n_grains, s.grains.len(), "grain count");
     // y up: a true grain near the top of the image has a large y in metres.
     let top = s.grains.iter().min_by(|a, b| a.y.total_cmp(&b.y)).unwrap();
     let y_top_m = (300.0 - top.y) * px;
     assert!(
-        rows.iter().any(|r| (r[2] - y_top_m).abs() < 20.0 * px),
+        ys.iter().any(|y| (y - y_top_m).abs() < 20.0 * px),
         "no circle near the top grain's y = {y_top_m}"
     );
     // Mean diameter in metres within 3 % of the truth.

@@ -74,14 +74,15 @@ fn fake_run(dir: &Path, d: &[[f64; 3]], h: [[f64; 2]; 2], shift: [f64; 2]) -> Pa
     run
 }
 
+/// The last row of a table, every numeric column by name (text columns left out).
 fn csv_row(path: &Path) -> std::collections::HashMap<String, f64> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let last: Vec<&str> = lines.last().unwrap().split(',').collect();
-    head.iter()
-        .zip(last)
-        .map(|(h, v)| (h.to_string(), v.parse().unwrap_or(f64::NAN)))
+    let df = lbdem::report::table::read_table(path).unwrap();
+    df.get_column_names()
+        .iter()
+        .filter_map(|h| {
+            let v = lbdem::report::table::f64_column(&df, h, path).ok()?;
+            Some((h.to_string(), *v.last()?))
+        })
         .collect()
 }
 

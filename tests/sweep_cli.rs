@@ -4,6 +4,7 @@
 
 mod common;
 use common::run;
+use lbdem::report::table;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -13,18 +14,13 @@ fn repo(p: &str) -> PathBuf {
 }
 
 fn column(csv: &Path, name: &str) -> Vec<String> {
-    let text = std::fs::read_to_string(csv).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let k = header
-        .iter()
-        .position(|h| *h == name)
-        .unwrap_or_else(|| panic!("{name} not in {header:?}"));
-    lines.map(|l| l.split(',').nth(k).unwrap().to_string()).collect()
+    let df = table::read_table(csv).unwrap();
+    table::str_column(&df, name, csv).unwrap()
 }
 
 fn numbers(csv: &Path, name: &str) -> Vec<f64> {
-    column(csv, name).iter().map(|v| v.parse().unwrap()).collect()
+    let df = table::read_table(csv).unwrap();
+    table::f64_column(&df, name, csv).unwrap()
 }
 
 /// sweeps/su2020-ci.toml as CI runs it (also under MPI: scripts/mpi-sweep-check.sh).
