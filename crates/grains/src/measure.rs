@@ -117,14 +117,28 @@ fn measure_one(px: &GrainPixels, g: usize, inside: ArrayView2<bool>) -> GrainMea
     let cxx = sxx / n - mx * mx + 1.0 / 12.0;
     let cyy = syy / n - my * my + 1.0 / 12.0;
     let cxy = sxy / n - mx * my;
-    let half_tr = 0.5 * (cxx + cyy);
-    let disc = (0.25 * (cxx - cyy).powi(2) + cxy * cxy).sqrt();
-    let (l1, l2) = (half_tr + disc, (half_tr - disc).max(1e-12));
-    // Angle in image axes (y down), then flipped to y up.
-    let theta_down = 0.5 * (2.0 * cxy).atan2(cxx - cyy);
+    // Principal axes of the pixel covariance (the 2x2 symmetric eigenproblem).
+    let eig = nalgebra::SymmetricEigen::new(nalgebra::Matrix2::new(cxx, cxy, cxy, cyy));
+    let major = if eig.eigenvalues[0] >= eig.eigenvalues[1] {
+        0
+    } else {
+        1
+    };
+    let (l1, l2) = (eig.eigenvalues[major], eig.eigenvalues[1 - major].max(1e-12));
+    let v = eig.eigenvectors.column(major);
+    // Angle of the major axis in image axes (y down), then flipped to y up, in (-pi/2, pi/2];
+    // a round grain (no major axis) gets 0.
+    let theta_down = if l1 - l2 <= 1e-12 * l1.abs() {
+        0.0
+    } else {
+        v[1].atan2(v[0])
+    };
     let mut orientation = -theta_down;
-    if orientation <= -std::f64::consts::FRAC_PI_2 {
+    while orientation <= -std::f64::consts::FRAC_PI_2 {
         orientation += std::f64::consts::PI;
+    }
+    while orientation > std::f64::consts::FRAC_PI_2 {
+        orientation -= std::f64::consts::PI;
     }
     GrainMeasure {
         label: g as u32 + 1,

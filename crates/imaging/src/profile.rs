@@ -4,6 +4,7 @@
 //! the Young-Laplace pressure drop `dp = -2 gamma / R` (Eq. 23).
 
 use crate::{ImagingError, Result, Roi};
+use nalgebra::{DMatrix, DVector};
 use ndarray::ArrayView2;
 use serde::{Deserialize, Serialize};
 
@@ -90,41 +91,23 @@ pub fn quadratic_fit(x: &[f64], y: &[f64], x0: f64) -> Result<[f64; 3]> {
             "need at least three (x, y) pairs",
         ));
     }
-    let mut m = [[0.0f64; 4]; 3];
-    for (&xi, &yi) in x.iter().zip(y) {
-        let t = xi - x0;
-        let p = [1.0, t, t * t];
-        for i in 0..3 {
-            for j in 0..3 {
-                m[i][j] += p[i] * p[j];
-            }
-            m[i][3] += p[i] * yi;
-        }
+    // The design matrix [1, t, t^2] solved in the least-squares sense by SVD (rank-revealing:
+    // points at fewer than three distinct x cannot fix a parabola).
+    let a = DMatrix::from_fn(x.len(), 3, |i, j| (x[i] - x0).powi(j as i32));
+    let b = DVector::from_column_slice(y);
+    let svd = a.svd(true, true);
+    let tol = 1e-12 * svd.singular_values.max();
+    if svd.rank(tol) < 3 {
+        return Err(ImagingError::invalid(
+            "fit points",
+            x.len(),
+            "are degenerate (fewer than three distinct x)",
+        ));
     }
-    // Gaussian elimination with partial pivoting on the 3x4 augmented matrix.
-    for col in 0..3 {
-        let piv = (col..3)
-            .max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))
-            .unwrap_or(col);
-        m.swap(col, piv);
-        if m[col][col].abs() < 1e-300 {
-            return Err(ImagingError::invalid(
-                "fit points",
-                x.len(),
-                "are degenerate (all at one x)",
-            ));
-        }
-        for r in 0..3 {
-            if r != col {
-                let f = m[r][col] / m[col][col];
-                let pivot_row = m[col];
-                for (x, p) in m[r].iter_mut().zip(pivot_row).skip(col) {
-                    *x -= f * p;
-                }
-            }
-        }
-    }
-    Ok([m[0][3] / m[0][0], m[1][3] / m[1][1], m[2][3] / m[2][2]])
+    let c = svd
+        .solve(&b, tol)
+        .map_err(|e| ImagingError::invalid("fit points", x.len(), e))?;
+    Ok([c[0], c[1], c[2]])
 }
 
 /// Result of the meniscus fit along a thickness line scan.
@@ -186,6 +169,22 @@ mod tests {
         assert!(
             (f.slope - 2.0).abs() < 1e-12 && (f.intercept - 1.0).abs() < 1e-12 && (f.r2 - 1.0).abs() < 1e-12
         );
+    }
+
+    #[test]
+    fn quadratic_fit_exact_and_degenerate() {
+        let x: Vec<f64> = (0..7).map(|i| i as f64 * 0.3).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .map(|t| 2.0 - 0.5 * (t - 1.0) + 3.0 * (t - 1.0).powi(2))
+            .collect();
+        let c = quadratic_fit(&x, &y, 1.0).unwrap();
+        for (got, want) in c.iter().zip([2.0, -0.5, 3.0]) {
+            assert!((got - want).abs() < 1e-12, "{c:?}");
+        }
+        // Two distinct x cannot fix a parabola.
+        let err = quadratic_fit(&[1.0, 1.0, 2.0, 2.0], &[0.0, 0.1, 1.0, 1.1], 0.0).unwrap_err();
+        assert!(err.to_string().contains("degenerate"), "{err}");
     }
 
     /// Su et al. (2020) Sect. 4.4: R ~ 100 um with gamma ~ 0.7 J/m^2 gives dp ~ -14.00 kPa (Eq. 23).
