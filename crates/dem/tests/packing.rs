@@ -8,6 +8,8 @@
 //! `cargo test --release -p lbdem-dem --test packing -- --ignored`.
 //! Tolerance: 0.84 ± 0.02 covers the finite-size spread of φ_J at N ~ 10³ reported by O'Hern
 //! et al. (their Fig. on the width of the φ_J distribution) and the finite compression rate.
+//! Measured (2026-11-25): frictionless φ = 0.8399 at 1000 disks, 0.8410 at 4000; μ = 0.5:
+//! 0.8057 and 0.8067.
 
 use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::*;
@@ -71,17 +73,35 @@ fn compress(n: usize, mu: f64, seed: u64) -> (f64, System, LinearSpringDashpot, 
     let mut p = StepParams::new(0.2 * crit, 0.2);
     p.local_damping = 0.2;
     let target = 1.0; // σ/k_n = 1e-4: overlaps of 1e-4 d, close to the jamming point
+    // The walls travel about 0.14 L each from φ = 0.45 to jamming, so the run length grows with
+    // the box side L ∝ √n. A cap of 30 000 steps left 1000 disks 30 % off the target stress
+    // (their φ passed by luck) and stopped 4000 at φ = 0.63 (2026-11-24); 60 000 at 1000 disks
+    // reach it (error 0.033).
+    let max_steps = (60_000.0 * (n as f64 / 1000.0).sqrt()).ceil() as u64;
     let c = generate::Compression {
         target_stress: target,
         alpha: 0.05,
         v_max: 0.3,
         tolerance: 0.05,
         v_threshold: 1e-3,
-        max_steps: 30_000,
+        max_steps,
     };
     let mut st = Stepper::new();
     let steps = generate::compress_isotropic(&mut s, &law, &law, &p, &c, &mut st).unwrap();
-    eprintln!("mu = {mu}: compression took {steps} steps");
+    eprintln!("mu = {mu}: compression took {steps} steps (cap {max_steps})");
+    // The packing fraction means something only at the target stress. The servo's full stop
+    // (also every grain slower than v_threshold) is not reached: rattlers, grains without
+    // contacts, keep their speed (1.2e-2 at 1000 disks, frictionless), so the cap ends the run;
+    // what is checked is that the walls hold the target stress (error 0.033 measured).
+    let (_, err) = generate::servo_settled(&s, &c);
+    eprintln!(
+        "wall stress error {err:.3}, largest grain speed {:.1e}",
+        s.bodies.max_speed()
+    );
+    assert!(
+        err < c.tolerance,
+        "mu = {mu}: wall stress {err} off the target after {steps} steps"
+    );
     // Interior window 3 large diameters away from every wall (no wall layering).
     let gx = Wall::gap(&s.walls[0], &s.walls[1]);
     let gy = Wall::gap(&s.walls[2], &s.walls[3]);
