@@ -4,6 +4,7 @@
 
 pub mod chart;
 pub mod pareto;
+pub mod run_pairs;
 pub mod studies;
 
 /// One run of a study: a setting, its error against the study's reference and its wall time.

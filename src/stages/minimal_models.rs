@@ -5,6 +5,7 @@
 //! `[scene] minimal = true` applies what this table shows harmless (src/scenes/schema/simplify.rs).
 
 use crate::atlas::chart::markers_and_line;
+use crate::atlas::run_pairs::run_shifts;
 use crate::atlas::studies::{Shift, paired_shifts, sweep_tables};
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::plot::{XyPlot, xy_png};
@@ -12,6 +13,7 @@ use crate::report::table::{Col, str_column, write_table};
 use crate::scenes::schema::simplify;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -32,13 +34,19 @@ pub struct Study {
     pub family: String,
     /// The case, in a few words (a column of the table).
     pub study: String,
-    /// The sweep's out directory.
-    pub sweep: PathBuf,
+    /// The sweep's out directory...
+    #[serde(default)]
+    pub sweep: Option<PathBuf>,
+    /// ...or one finished simulate stage per simplification (`reference` among them), for runs
+    /// too long for a sweep: the result is the last value of that series column
+    /// (`atlas::run_pairs`).
+    #[serde(default)]
+    pub runs: Option<BTreeMap<String, PathBuf>>,
     #[serde(default = "simplify_axis")]
     pub axis: String,
     #[serde(default = "none")]
     pub reference: String,
-    /// The result column of the sweep, and the change in it that a user accepts.
+    /// The result column of the sweep (of the runs' series), and the change in it a user accepts.
     pub result: String,
     pub tolerance: f64,
     /// Where the tolerance comes from (a sentence for the caption).
@@ -85,23 +93,44 @@ impl Stage for MinimalModels {
     type Params = Params;
 
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
-        sweep_tables(p.studies.iter().map(|s| ctx.resolve(&s.sweep)))
+        let mut v = sweep_tables(
+            p.studies
+                .iter()
+                .filter_map(|s| s.sweep.as_ref())
+                .map(|d| ctx.resolve(d)),
+        );
+        for runs in p.studies.iter().filter_map(|s| s.runs.as_ref()) {
+            for d in runs.values() {
+                v.extend(["series.csv", "stage.json"].map(|f| ctx.resolve(d).join(f)));
+            }
+        }
+        v
     }
 
     fn run(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         check(p)?;
         let mut rows: Vec<Row> = Vec::new();
         for s in &p.studies {
-            let dir = ctx.resolve(&s.sweep);
-            let shifts = paired_shifts(
-                &s.study,
-                &dir,
-                &s.axis,
-                &s.reference,
-                &s.result,
-                str_column,
-                s.time.as_deref(),
-            )?;
+            let (shifts, source) = match (&s.sweep, &s.runs) {
+                (Some(sweep), _) => {
+                    let dir = ctx.resolve(sweep);
+                    let shifts = paired_shifts(
+                        &s.study,
+                        &dir,
+                        &s.axis,
+                        &s.reference,
+                        &s.result,
+                        str_column,
+                        s.time.as_deref(),
+                    )?;
+                    (shifts, dir.display().to_string())
+                }
+                (None, Some(runs)) => (
+                    run_shifts(&s.study, runs, &s.reference, &s.result, |d| ctx.resolve(d))?,
+                    "the runs".to_string(),
+                ),
+                (None, None) => unreachable!("check() refuses a study with neither"),
+            };
             let full_wall = shifts
                 .iter()
                 .find(|x| x.at == s.reference)
@@ -111,9 +140,8 @@ impl Stage for MinimalModels {
                 for name in shift.at.split('+') {
                     if simplify::find(name.trim()).is_none() {
                         bail!(
-                            "minimal-models: study '{}': {} holds '{name}', not a simplification",
-                            s.study,
-                            dir.display()
+                            "minimal-models: study '{}': {source} holds '{name}', not a simplification",
+                            s.study
                         );
                     }
                 }
@@ -141,14 +169,17 @@ impl Stage for MinimalModels {
                     "{} ({}): per simplification, the change in {} against the full model on the same replicas \
                      (|mean paired shift| + 2 standard errors; the shift itself for one realisation) over the \
                      tolerance {} ({}), against the wall time it saves (1 - the median over replicas of its wall \
-                     time over the full model's on the same replica, from {}). Below the line: harmless. A simplification with failed replicas is not \
-                     drawn and is not harmless.",
+                     time over the full model's on the same replica, from {}). Below the line: harmless. A simplification with failed replicas, \
+                     or without a measured wall time (a run resumed across sessions), is not drawn; the first is not harmless.",
                     s.study,
                     s.family,
                     s.result,
                     s.tolerance,
                     s.why,
-                    s.sweep.display()
+                    match (&s.sweep, &s.runs) {
+                        (Some(d), _) => d.display().to_string(),
+                        _ => "finished simulate stages, one per simplification".to_string(),
+                    }
                 ),
             });
             files.push(file.into());
@@ -250,7 +281,7 @@ fn write(path: &std::path::Path, rows: &[Row]) -> Result<()> {
 fn chart(path: &std::path::Path, s: &Study, rows: &[Row]) -> Result<()> {
     let mine: Vec<&Row> = rows
         .iter()
-        .filter(|r| std::ptr::eq(r.study, s) && r.shift.bound().is_finite())
+        .filter(|r| std::ptr::eq(r.study, s) && r.shift.bound().is_finite() && r.time_saved().is_finite())
         .collect();
     let data: Vec<(String, Vec<f64>, Vec<f64>)> = mine
         .iter()
@@ -288,6 +319,14 @@ fn check(p: &Params) -> Result<()> {
                 "minimal-models: study '{}': family = {:?}; give one of {FAMILIES:?} (the scenes a row speaks for)",
                 s.study,
                 s.family
+            );
+        }
+        if s.sweep.is_some() == s.runs.is_some() {
+            bail!(
+                "minimal-models: study '{}': give either sweep = \"DIR\" (a finished sweep) or runs = {{ none = \"DIR\", ... }} \
+                 (one finished simulate stage per simplification), not {}",
+                s.study,
+                if s.sweep.is_some() { "both" } else { "neither" }
             );
         }
         if !(s.tolerance > 0.0 && s.tolerance.is_finite()) {
@@ -333,7 +372,8 @@ mod tests {
             studies: vec![Study {
                 family: "shear-cell".into(),
                 study: "test cell".into(),
-                sweep: sweep.clone(),
+                sweep: Some(sweep.clone()),
+                runs: None,
                 axis: simplify_axis(),
                 reference: none(),
                 result: "eps".into(),
