@@ -181,6 +181,34 @@ impl Vec3 {
     }
 }
 
+/// To nalgebra, where the rotations (quaternions, eigen-decompositions) are.
+impl From<Vec3> for nalgebra::Vector3<f64> {
+    #[inline]
+    fn from(v: Vec3) -> Self {
+        nalgebra::Vector3::new(v.x, v.y, v.z)
+    }
+}
+
+impl From<nalgebra::Vector3<f64>> for Vec3 {
+    #[inline]
+    fn from(v: nalgebra::Vector3<f64>) -> Self {
+        Vec3::new(v.x, v.y, v.z)
+    }
+}
+
+impl Vec3 {
+    /// `self` turned by the rotation `q`.
+    #[inline]
+    pub fn rotated_by(self, q: &nalgebra::UnitQuaternion<f64>) -> Vec3 {
+        q.transform_vector(&self.into()).into()
+    }
+    /// `self` turned by the inverse of `q`.
+    #[inline]
+    pub fn rotated_back_by(self, q: &nalgebra::UnitQuaternion<f64>) -> Vec3 {
+        q.inverse_transform_vector(&self.into()).into()
+    }
+}
+
 impl Vector for Vec3 {
     const DIM: usize = 3;
     type Angular = Vec3;

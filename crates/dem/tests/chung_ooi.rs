@@ -1,18 +1,21 @@
 //! Chung & Ooi (2011), "Benchmark tests for verifying discrete element modelling codes at
 //! particle impact level", Granular Matter 13:643-656: Tests 1-4 on the 3D sphere engine
-//! (`lbdem_dem::spheres`, Hertz-Mindlin with the Mindlin tangential spring).
+//! (`lbdem_dem::spheres`, [`HertzMindlinSpring`]).
 //!
-//! Materials, radii and speeds per test as in the paper's tables, read here from the two public
-//! implementations that carry them (Yade `examples/ChungOoi/Test*.py`, Kratos
-//! `DEMApplication/tests/DEM3D_chung_ooi_tests`). Reference values: Hertz theory in closed form
-//! (Tests 1-2), the input restitution (Test 3), the published normalised curves of Test 4 as
-//! digitised in the Kratos test data (`benchmark4_graph{1,2,3}_ref.dat`) and the exact
-//! gross-sliding limit. Every tolerance is about twice the error measured here (in a comment).
+//! Materials, radii and speeds per test as two public implementations of the benchmark set
+//! them up (Yade `examples/ChungOoi/Test*.py`, Kratos `DEMApplication` Chung-Ooi tests); the
+//! paper itself was not at hand. The references that carry the weight are independent of any
+//! digitisation: Hertz theory in closed form (Tests 1-2), the input restitution (Test 3), the
+//! exact gross-sliding limit and an RK4 integration of the no-slip limit (Test 4). The "paper"
+//! curves are third-party digitisations of the paper's figures (Kratos `paper_data/
+//! benchmark{1,2,4}_graph*.dat`; the figure numbers are not verified here), so agreement with
+//! them is bounded by their resolution. Every tolerance is about twice the error measured here
+//! (in a comment).
 //!
 //! Run: `cargo test -p lbdem-dem --test chung_ooi -- --nocapture` (about a second; CI runs it).
 
 use lbdem_dem::spheres::{
-    Domain3, Elastic, HertzMindlin, PlaneWall, SphereStepParams, SphereStepper, SphereSystem, Surface,
+    Domain3, Elastic, HertzMindlinSpring, PlaneWall, SphereStepParams, SphereStepper, SphereSystem, Surface,
 };
 use lbdem_dem::{Vec3, Vector};
 use std::f64::consts::PI;
@@ -68,8 +71,8 @@ const AL_ALLOY_T4: Material = Material {
 };
 
 impl Material {
-    fn law(&self, mu: f64, restitution: f64) -> HertzMindlin {
-        HertzMindlin::uniform(
+    fn law(&self, mu: f64, restitution: f64) -> HertzMindlinSpring {
+        HertzMindlinSpring::uniform(
             Elastic {
                 young: self.young,
                 poisson: self.poisson,
@@ -122,7 +125,7 @@ fn open_box(half: f64) -> Domain3 {
 /// changes sign.
 fn run_impact(
     mut sys: SphereSystem,
-    law: &HertzMindlin,
+    law: &HertzMindlinSpring,
     dt: f64,
     max_steps: usize,
     overlap: impl Fn(&SphereSystem) -> f64,
@@ -192,7 +195,7 @@ fn two_spheres(m: &Material, r: f64, v: f64, steps_per_contact: f64) -> (Impact,
 /// A sphere of radius `r` hitting the rigid plane z = 0 at velocity `v` (z-component < 0).
 fn sphere_on_plane(
     m: &Material,
-    law: &HertzMindlin,
+    law: &HertzMindlinSpring,
     r: f64,
     v: Vec3,
     steps_per_contact: f64,
@@ -249,17 +252,18 @@ fn test1_two_identical_spheres_match_hertz() {
             glass = Some(i);
         }
     }
-    // Paper, Test 1 force-time curve for glass (as digitised in Kratos' benchmark1_graph2.dat):
-    // peak 10.704 kN at 20.45 us, contact over at 40.48 us. Measured here 10.697 kN
-    // (6.5e-4) and 40.34 us (3.4e-3): digitisation resolution.
+    // The paper's Test 1 force-time curve for glass as digitised by Kratos
+    // (benchmark1_graph2.dat): peak 10.704 kN at 20.45 us, contact over at 40.48 us. Measured
+    // here 10.697 kN (6.5e-4) and 40.34 us (3.4e-3), the digitisation's resolution; this adds
+    // nothing to the closed-form check above beyond showing the set-up is the paper's.
     let g = glass.expect("glass ran");
     assert!(rel(g.f_max, 10.704e3) < 1.3e-3, "glass F_max {}", g.f_max);
     assert!(rel(g.t_c, 40.48e-6) < 7e-3, "glass t_c {}", g.t_c);
 }
 
 /// Test 2 (elastic normal impact of a sphere, R = 0.10 m at 0.2 m/s, on a rigid plane;
-/// aluminium and magnesium alloys): against Hertz theory, and the aluminium run against the
-/// paper's force-displacement curve.
+/// aluminium and magnesium alloys): against Hertz theory, and the aluminium run against a
+/// digitisation of the paper's force-displacement curve.
 #[test]
 fn test2_sphere_on_rigid_plane_matches_hertz() {
     for m in [&AL_ALLOY_T2, &MG_ALLOY] {
@@ -287,9 +291,11 @@ fn test2_sphere_on_rigid_plane_matches_hertz() {
         );
         assert!((i.vel.z - 0.2).abs() < 1.5e-9, "{}: rebound {}", m.name, i.vel.z);
         if m.name == "aluminium alloy" {
-            // Paper, Test 2 force-displacement curve (Kratos' benchmark2_graph1.dat): its last
-            // point, 11.326 kN at 49.99 um, taken as the peak. Measured 11.370 kN (3.9e-3) and
-            // 49.72 um (5.4e-3).
+            // The paper's Test 2 force-displacement curve as digitised by Kratos
+            // (benchmark2_graph1.dat) ends at 11.326 kN, 49.99 um; the digitisation does not
+            // say whether that is the peak, so this only checks that the run reaches the end of
+            // the digitised curve within its resolution. Measured 11.370 kN (3.9e-3) and
+            // 49.72 um (5.4e-3); Hertz in closed form (above) is the real check.
             assert!(rel(i.f_max, 11.326e3) < 8e-3, "F_max {}", i.f_max);
             assert!(rel(i.delta_max, 49.99e-6) < 1.1e-2, "delta_max {}", i.delta_max);
         }
@@ -312,8 +318,10 @@ fn test3_restitution_is_recovered() {
     }
     // Measured: at most 1.3e-4 off (cast iron, e = 0.2); the Tsuji/LIGGGHTS damping with its
     // attractive tail reproduces e for Hertz within the step resolution here.
+    println!("Test 3 worst restitution error {worst:.2e}");
     assert!(worst < 2.6e-4, "restitution off by {worst}");
-    // The paper's e = 0 case: the sphere comes to rest on the plane and stays in contact.
+    // e = 0 (β = −1, the damping's limit): the sphere comes to rest on the plane and stays
+    // in contact.
     let law = ALUMINA.law(0.0, 0.0);
     let mut sys = SphereSystem::new(open_box(0.025));
     sys.walls
@@ -344,7 +352,13 @@ fn test3_restitution_is_recovered() {
 /// An oblique impact on the rigid plane z = 0: speed `speed` at `angle_deg` from the normal.
 /// Returns (tangential restitution of the centre v_x'/v_x, ω_y', contact-point rebound angle
 /// atan(v_c'/v_n') in degrees, normal restitution).
-fn oblique(m: &Material, law: &HertzMindlin, r: f64, speed: f64, angle_deg: f64) -> (f64, f64, f64, f64) {
+fn oblique(
+    m: &Material,
+    law: &HertzMindlinSpring,
+    r: f64,
+    speed: f64,
+    angle_deg: f64,
+) -> (f64, f64, f64, f64) {
     let th = angle_deg * PI / 180.0;
     let v = Vec3::new(speed * th.sin(), 0.0, -speed * th.cos());
     let (i, _) = sphere_on_plane(m, law, r, v, 2000.0);
@@ -359,9 +373,12 @@ fn oblique(m: &Material, law: &HertzMindlin, r: f64, speed: f64, angle_deg: f64)
 
 /// Test 4 (oblique impact of an aluminium oxide sphere, R = 2.5 mm at 3.9 m/s, on a rigid
 /// plane; μ = 0.092, e = 0.98 as in Yade's and Kratos' set-ups): tangential restitution,
-/// spin and rebound angle against the paper's curves (Chung & Ooi 2011, Test 4 figures,
-/// aluminium oxide, as digitised in Kratos' benchmark4_graph{1,2,3}_ref.dat; the spin is
-/// plotted there with the opposite sign), and against the exact gross-sliding limit.
+/// spin and rebound angle against the paper's aluminium-oxide curves as digitised by Kratos
+/// (benchmark4_graph{1,2,3}.dat, first series; the spin is plotted there with the opposite
+/// sign; the same files' third series are Kharaz et al. 2001's experimental points, not used
+/// here), and against the exact gross-sliding limit. Kratos' graph3 file carries identical
+/// "Al. oxide" and "Al. alloy" series, so the rebound-angle curve is less certain than the
+/// other two.
 #[test]
 fn test4_oblique_impact_matches_the_paper_and_the_sliding_limit() {
     let law = ALUMINA.law(0.092, 0.98);
@@ -411,28 +428,44 @@ fn test4_oblique_impact_matches_the_paper_and_the_sliding_limit() {
         (79.8218, 78.701),
         (84.7833, 84.517),
     ];
-    let (mut d_et, mut d_om, mut d_reb) = (0.0f64, 0.0f64, 0.0f64);
+    // Largest deviations below 30 deg (sticking and micro-slip: the curves are steep there,
+    // 0.05 in e_t per degree near 5 deg, so digitisation offsets in angle count) and from
+    // 30 deg on (gross sliding).
+    let (mut d_et, mut d_om, mut d_reb) = ([0.0f64; 2], [0.0f64; 2], [0.0f64; 2]);
+    let regime = |a: f64| usize::from(a >= 29.5);
     for &(a, want) in &et_ref {
         let (et, ..) = oblique(&ALUMINA, &law, r, 3.9, a);
         println!("Test 4 e_t at {a:.2} deg: {et:.4} (paper {want:.4})");
-        d_et = d_et.max((et - want).abs());
+        d_et[regime(a)] = d_et[regime(a)].max((et - want).abs());
     }
     for &(a, want) in &omega_ref {
         let (_, w, ..) = oblique(&ALUMINA, &law, r, 3.9, a);
         println!("Test 4 omega at {a:.2} deg: {w:.1} rad/s (paper {want:.1})");
-        d_om = d_om.max((w - want).abs());
+        d_om[regime(a)] = d_om[regime(a)].max((w - want).abs());
     }
     for &(a, want) in &rebound_ref {
         let (_, _, reb, _) = oblique(&ALUMINA, &law, r, 3.9, a);
         println!("Test 4 rebound angle at {a:.2} deg: {reb:.2} deg (paper {want:.2})");
-        d_reb = d_reb.max((reb - want).abs());
+        d_reb[regime(a)] = d_reb[regime(a)].max((reb - want).abs());
     }
-    println!("Test 4 largest deviations: e_t {d_et:.4}, omega {d_om:.1} rad/s, rebound {d_reb:.2} deg");
-    // Measured: e_t 0.0144 (at 5.2 deg, where the curve falls 0.05 per degree; 0.0023 above
-    // 30 deg), omega 8.1 rad/s of 617 (at 10 deg), rebound angle 1.13 deg (at 15 deg).
-    assert!(d_et < 0.029, "e_t off the paper by {d_et}");
-    assert!(d_om < 16.0, "omega off the paper by {d_om} rad/s");
-    assert!(d_reb < 2.3, "rebound angle off the paper by {d_reb} deg");
+    println!(
+        "Test 4 largest deviations below / from 30 deg: e_t {:.4} / {:.4}, omega {:.1} / {:.1} rad/s, rebound {:.2} / {:.2} deg",
+        d_et[0], d_et[1], d_om[0], d_om[1], d_reb[0], d_reb[1]
+    );
+    // Measured below / from 30 deg: e_t 0.0143 (at 5.2 deg) / 0.0029, omega 8.1 (at 10 deg) /
+    // 3.7 rad/s of 617, rebound angle 1.13 (at 15 deg) / 0.35 deg.
+    assert!(
+        d_et[0] < 0.029 && d_et[1] < 0.0058,
+        "e_t off the paper by {d_et:?}"
+    );
+    assert!(
+        d_om[0] < 16.0 && d_om[1] < 7.4,
+        "omega off the paper by {d_om:?} rad/s"
+    );
+    assert!(
+        d_reb[0] < 2.3 && d_reb[1] < 0.7,
+        "rebound angle off the paper by {d_reb:?} deg"
+    );
 
     // Gross sliding (rigid-body impulse): for tan θ > (7/2) μ (1 + e_n) the contact slides
     // throughout, the tangential impulse is μ times the normal one, and
@@ -450,10 +483,10 @@ fn test4_oblique_impact_matches_the_paper_and_the_sliding_limit() {
         "Test 4 gross sliding: e_t off by {:.1e}, omega off by {:.1e} (relative)",
         worst.0, worst.1
     );
-    // Measured: e_t 1.0e-5; omega 1.2e-3 relative, below the rigid value because the friction
+    // Measured: e_t 1.9e-5; omega 1.2e-3 relative, below the rigid value because the friction
     // acts at the contact point, R − δ/2 from the centre (δ_max/R ≤ 2.8e-3 here).
     assert!(
-        worst.0 < 2e-5 && worst.1 < 2.4e-3,
+        worst.0 < 3.8e-5 && worst.1 < 2.4e-3,
         "gross-sliding limit off by {worst:?}"
     );
 }
@@ -529,6 +562,55 @@ fn test4_no_slip_limit_matches_an_independent_integration() {
             // being singular where the contact opens and closes; error ratios 5.1-19.6).
             assert!(err[0] < 2.3e-3 && err[1] < 4.4e-4, "{}: errors {err:?}", m.name);
             assert!(err[1] < err[0] / 3.0, "{}: no convergence {err:?}", m.name);
+        }
+    }
+}
+
+/// The accepted step against the error it gives: Tests 3 and 4 on aluminium oxide
+/// (R = 2.5 mm at 3.9 m/s, contact about 6 us, t_R = 1.4 us) at 20, 50 and 100 steps per
+/// contact — 0.22, 0.09 and 0.04 t_R; the default `rayleigh_fraction` 0.2 admits about 22 —
+/// with the fraction lifted to 1 so every step runs. Errors: restitution at e = 0.5, e_t at
+/// 45 deg against the exact gross-sliding value, the no-slip tangential restitution at 5 deg
+/// against the RK4 reference. The table is in `docs/dem3d.md`.
+#[test]
+fn error_against_steps_per_contact() {
+    let m = &ALUMINA;
+    let r = 0.0025;
+    let mass = m.rho * 4.0 / 3.0 * PI * r * r * r;
+    let loose = |mu: f64, e: f64| HertzMindlinSpring {
+        rayleigh_fraction: 1.0,
+        ..m.law(mu, e)
+    };
+    let t_r = loose(0.0, 1.0).rayleigh_time_step(r, mass);
+    let c = loose(1e6, 1.0).wall_coeffs();
+    let th5 = 5f64.to_radians();
+    let v5 = Vec3::new(3.9 * th5.sin(), 0.0, -3.9 * th5.cos());
+    let no_slip = no_slip_tangential_restitution(c.e_star, c.g_star, r, mass, -v5.z, v5.x);
+    let mut errs = Vec::new();
+    for n in [20.0, 50.0, 100.0] {
+        let (i, h) = sphere_on_plane(m, &loose(0.0, 0.5), r, Vec3::new(0.0, 0.0, -3.9), n);
+        let d_e = (i.vel.z / 3.9 - 0.5).abs();
+        let th = 45f64.to_radians();
+        let v = Vec3::new(3.9 * th.sin(), 0.0, -3.9 * th.cos());
+        let (j, _) = sphere_on_plane(m, &loose(0.092, 0.98), r, v, n);
+        let en = -j.vel.z / v.z;
+        let d_et = (j.vel.x / v.x - (1.0 - 0.092 * (1.0 + en) / th.tan())).abs();
+        let (k, _) = sphere_on_plane(m, &loose(1e6, 1.0), r, v5, n);
+        let d_ns = ((k.vel.x - k.omega.y * r) / v5.x - no_slip).abs();
+        println!(
+            "{n} steps per contact (dt = {:.3} t_R): restitution off by {d_e:.1e}, e_t at 45 deg {d_et:.1e}, no-slip at 5 deg {d_ns:.1e}",
+            h.t_c / n / t_r
+        );
+        errs.push([d_e, d_et, d_ns]);
+    }
+    // Measured (20 / 50 / 100 steps per contact): restitution 1.5e-3 / 9.2e-4 / 1.2e-3 (the
+    // restitution model's own error at this e, not the step's), e_t at 45 deg 2e-16 / 1.3e-5 /
+    // 8.0e-6, no-slip 1.9e-2 / 1.5e-2 / 1.5e-2 (first order, 1.1e-3 at 2000). Tolerances twice
+    // the worst of each row.
+    let tol = [3e-3, 2.6e-5, 3.8e-2];
+    for e in &errs {
+        for k in 0..3 {
+            assert!(e[k] < tol[k], "{errs:?}");
         }
     }
 }

@@ -4,12 +4,18 @@
 
 use lbdem_dem::spheres::clump::DEFAULT_NODES;
 use lbdem_dem::spheres::{
-    ClumpTemplate, Domain3, Elastic, HertzMindlin, PlaneWall, SphereStepParams, SphereStepper, SphereSystem,
-    Surface,
+    BodyFrame, ClumpTemplate, Domain3, Elastic, HertzMindlinSpring, PlaneWall, SphereStepParams,
+    SphereStepper, SphereSystem, Surface,
 };
-use lbdem_dem::{Vec3, Vector};
+use lbdem_dem::{Histories, Vec3, Vector};
 use nalgebra::{UnitQuaternion, Vector3};
 use std::f64::consts::PI;
+
+/// Contacts whose tangential spring is loaded.
+fn live(h: &Histories) -> usize {
+    h.as_slice::<Vec3>()
+        .map_or(0, |x| x.iter().filter(|x| x.norm2() > 0.0).count())
+}
 
 fn rel(a: f64, b: f64) -> f64 {
     (a / b - 1.0).abs()
@@ -71,10 +77,23 @@ fn union_mass_properties_match_closed_forms() {
     println!("lens union at 24 nodes: {coarse:.1e}");
     assert!(coarse > 30.0 * ev2, "{coarse:e} vs {ev2:e}");
     assert!(ClumpTemplate { spheres: vec![] }.union_props(8).is_err());
+    // Too few quadrature nodes and a bad density are refused, not silently changed.
+    let err = two.union_props(3).unwrap_err().to_string();
+    assert!(err.contains("quadrature nodes") && err.contains('3'), "{err}");
+    assert!(BodyFrame::of(&two, -1.0, DEFAULT_NODES).is_err());
+    // A clump given a non-finite velocity is refused naming the clump.
+    let mut sys = SphereSystem::new(open_box(0.1));
+    let frame = BodyFrame::of(&two, 2500.0, DEFAULT_NODES).unwrap();
+    let v = Vec3::new(f64::NAN, 0.0, 0.0);
+    let err = sys
+        .add_clump(&frame, Vec3::ZERO, UnitQuaternion::identity(), v, Vec3::ZERO)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("clump 0") && sys.spheres.is_empty(), "{err}");
 }
 
-fn law() -> HertzMindlin {
-    HertzMindlin::uniform(
+fn law() -> HertzMindlinSpring {
+    HertzMindlinSpring::uniform(
         Elastic {
             young: 5e7,
             poisson: 0.3,
@@ -101,45 +120,78 @@ fn open_box(l: f64) -> Domain3 {
     Domain3::new(Vec3::new(-l, -l, -l), Vec3::new(l, l, l), [false; 3]).unwrap()
 }
 
-/// A free asymmetric body keeps its angular momentum to rounding and its energy to a bounded
-/// error, and its orientation converges at second order in dt.
+/// Euler's equations of a free rigid body in its principal frame, dL_b/dt = L_b × I⁻¹ L_b,
+/// integrated by RK4 with `steps` steps over `t`: an independent reference for the body-frame
+/// angular momentum (the engine keeps the world-frame L and turns the orientation instead).
+fn euler_rk4(l: Vector3<f64>, inertia: Vec3, t: f64, steps: usize) -> Vector3<f64> {
+    let i = Vector3::new(inertia.x, inertia.y, inertia.z);
+    let f = |l: Vector3<f64>| l.cross(&l.component_div(&i));
+    let h = t / steps as f64;
+    let mut l = l;
+    for _ in 0..steps {
+        let k1 = f(l);
+        let k2 = f(l + k1 * (0.5 * h));
+        let k3 = f(l + k2 * (0.5 * h));
+        let k4 = f(l + k3 * h);
+        l += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
+    }
+    l
+}
+
+/// A free asymmetric body tumbles as Euler's equations say: its body-frame angular momentum
+/// follows an independent RK4 integration, converging at second order in dt; the energy error
+/// stays bounded.
 #[test]
 fn free_asymmetric_clump_rotates_as_a_rigid_body() {
+    // No contacts here: the step resolves only the rotation, so the law's Rayleigh bound (on
+    // the smallest member, 3.9e-6 s at 0.2) is lifted to the full Rayleigh step.
+    let free_law = HertzMindlinSpring {
+        rayleigh_fraction: 1.0,
+        ..law()
+    };
+    let frame = BodyFrame::of(&asymmetric(), 2500.0, DEFAULT_NODES).unwrap();
     let spin = |dt: f64, steps: usize| {
         let mut sys = SphereSystem::new(open_box(0.1));
         let q0 = UnitQuaternion::from_euler_angles(0.3, -0.2, 0.9);
         // Spinning mostly about the intermediate axis: the unstable (tumbling) case.
         sys.add_clump(
-            &asymmetric(),
+            &frame,
             Vec3::ZERO,
             q0,
             Vec3::new(0.1, 0.0, 0.0),
             Vec3::new(20.0, 300.0, -15.0),
-            2500.0,
-            DEFAULT_NODES,
         )
         .unwrap();
-        let (l0, e0) = (sys.clumps.ang_mom[0], sys.kinetic_energy());
+        let e0 = sys.kinetic_energy();
         let mut st = SphereStepper::new();
         let p = SphereStepParams::new(dt, 1e-4);
         let mut worst_e = 0.0f64;
         for _ in 0..steps {
-            st.step(&p, &law(), &mut sys).unwrap();
+            st.step(&p, &free_law, &mut sys).unwrap();
             worst_e = worst_e.max(rel(sys.kinetic_energy(), e0));
         }
-        let dl = (sys.clumps.ang_mom[0] - l0).norm() / l0.norm();
-        (sys, dl, worst_e)
+        (sys, worst_e)
     };
-    let (a, dl, de) = spin(1e-5, 4000);
-    let (b, _, _) = spin(0.5e-5, 8000);
-    let (c, _, _) = spin(0.25e-5, 16000);
-    let q = |s: &SphereSystem| s.clumps.orientation(0);
-    let (e1, e2) = (q(&a).angle_to(&q(&c)), q(&b).angle_to(&q(&c)));
-    println!("L drift {dl:.1e}, worst energy error {de:.1e}, orientation error {e1:.2e} -> {e2:.2e} rad");
-    // Measured: L untouched (0: the drift never changes L), energy 4.3e-7 at the coarse step,
-    // orientation error ratio 5.0 when dt halves (second order, the reference itself at dt/4).
-    assert!(dl == 0.0, "{dl:e}");
+    let (a, de) = spin(1e-5, 4000);
+    let (b, _) = spin(0.5e-5, 8000);
+    // The reference: body-frame L at t = 0.04 s from the initial state.
+    let c0 = &spin(1e-5, 0).0.clumps;
+    let lb0: Vector3<f64> = c0.ang_mom[0].rotated_back_by(&c0.orientation(0)).into();
+    let want = euler_rk4(lb0, c0.inertia[0], 0.04, 400_000);
+    let lb = |s: &SphereSystem| -> Vector3<f64> {
+        s.clumps.ang_mom[0]
+            .rotated_back_by(&s.clumps.orientation(0))
+            .into()
+    };
+    let (e1, e2) = (
+        (lb(&a) - want).norm() / want.norm(),
+        (lb(&b) - want).norm() / want.norm(),
+    );
+    println!("worst energy error {de:.1e}, body-frame L off RK4 by {e1:.2e} (dt) -> {e2:.2e} (dt/2)");
+    // Measured: energy 4.3e-7 at the coarse step; body-frame L 1.56e-6 then 3.91e-7 of |L|,
+    // ratio 4.0 when dt halves (second order).
     assert!(de < 9e-7, "{de:e}");
+    assert!(e1 < 3.2e-6 && e2 < 8e-7, "{e1:e} {e2:e}");
     assert!(e1 / e2 > 3.5, "{e1:e} {e2:e}");
     // The members moved with the body.
     let s = &a.spheres;
@@ -153,13 +205,11 @@ fn free_asymmetric_clump_rotates_as_a_rigid_body() {
 fn clump_sphere_collision_conserves_momentum_and_angular_momentum() {
     let mut sys = SphereSystem::new(open_box(0.05));
     sys.add_clump(
-        &asymmetric(),
+        &BodyFrame::of(&asymmetric(), 2500.0, DEFAULT_NODES).unwrap(),
         Vec3::ZERO,
         UnitQuaternion::identity(),
         Vec3::new(0.5, 0.0, 0.0),
         Vec3::new(0.0, 0.0, 40.0),
-        2500.0,
-        DEFAULT_NODES,
     )
     .unwrap();
     sys.add_sphere(
@@ -186,9 +236,9 @@ fn clump_sphere_collision_conserves_momentum_and_angular_momentum() {
     let dl = (l1 - l0).norm() / (mass * 0.5 * 5e-3);
     println!("momentum {dp:.1e}, angular momentum {dl:.1e}, energy {e0:.3e} -> {e1:.3e}");
     assert!(touched, "no contact");
-    // Measured: 2.9e-16 and 5.2e-14 after 8000 steps (rounding of the positions, accumulated);
+    // Measured: 2.5e-16 and 1.6e-14 after 8000 steps (rounding of the positions, accumulated);
     // e = 0.5 dissipates.
-    assert!(dp < 6e-16 && dl < 1.1e-13, "{dp:e} {dl:e}");
+    assert!(dp < 5e-16 && dl < 3.2e-14, "{dp:e} {dl:e}");
     assert!(e1 < 0.9 * e0);
 }
 
@@ -205,13 +255,11 @@ fn tetrahedron_comes_to_rest_on_three_spheres() {
     // Tilted so that one sphere lands first.
     let q = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.4);
     sys.add_clump(
-        &tet,
+        &BodyFrame::of(&tet, 2500.0, DEFAULT_NODES).unwrap(),
         Vec3::new(0.0, 0.0, 4e-3),
         q,
         Vec3::new(0.05, 0.0, -0.3),
         Vec3::ZERO,
-        2500.0,
-        DEFAULT_NODES,
     )
     .unwrap();
     let mut st = SphereStepper::new();
@@ -241,14 +289,15 @@ fn tetrahedron_comes_to_rest_on_three_spheres() {
         (rest - z) / delta,
         ((rest - z) / delta - 1.0).abs()
     );
-    // Measured: the centre sits δ = 1.434e-7 m below the contact height, to 6.3e-12 of δ (the
-    // three contacts share the weight equally), after 0.3 s; KE 1.8e-32 J, rounding level.
+    // Measured: the centre sits δ = 1.434e-7 m below the contact height, to 7.8e-12 of δ (the
+    // three contacts share the weight equally), after 0.3 s; KE 3.1e-31 J, rounding level
+    // (1e-31 J is a velocity of 1e-12 m/s on this 8e-6 kg clump).
     assert!(
-        ((rest - z) / delta - 1.0).abs() < 1.3e-11,
+        ((rest - z) / delta - 1.0).abs() < 1.6e-11,
         "{} vs {delta}",
         rest - z
     );
-    assert!(ke < 1e-28, "{ke}");
+    assert!(ke < 6.2e-31, "{ke}");
 }
 
 /// A run with clumps and free spheres resumes from a JSON checkpoint bit for bit.
@@ -261,18 +310,17 @@ fn checkpoint_with_clumps_round_trips() {
         sys.walls
             .push(PlaneWall::new(Vec3::ZERO, Vec3::new(0.0, 0.0, 1.0)).unwrap());
         let tet = ClumpTemplate::tetrahedron(0.6e-3, 0.9e-3);
+        let frame = BodyFrame::of(&tet, 2500.0, DEFAULT_NODES).unwrap();
         for k in 0..8 {
             let (i, j) = ((k % 2) as f64, ((k / 2) % 2) as f64);
             let z = 1.5e-3 + 2.2e-3 * (k / 4) as f64;
             let q = UnitQuaternion::from_euler_angles(0.1 * k as f64, 0.3, -0.2 * k as f64);
             sys.add_clump(
-                &tet,
+                &frame,
                 Vec3::new(2e-3 + 4e-3 * i, 2e-3 + 4e-3 * j, z),
                 q,
                 Vec3::new(0.05 * i, -0.05 * j, -0.2),
                 Vec3::new(0.0, 30.0, 10.0),
-                2500.0,
-                DEFAULT_NODES,
             )
             .unwrap();
             sys.add_sphere(
@@ -297,8 +345,7 @@ fn checkpoint_with_clumps_round_trips() {
         let mut most = 0;
         for _ in 0..n {
             st.step(&p, &law(), sys).unwrap();
-            let live = sys.contacts.xi.iter().filter(|x| x.norm2() > 0.0).count()
-                + sys.contacts.wall_xi.iter().filter(|x| x.norm2() > 0.0).count();
+            let live = live(&sys.contacts.hist) + live(&sys.contacts.wall_hist);
             most = most.max(live);
         }
         most
@@ -307,8 +354,7 @@ fn checkpoint_with_clumps_round_trips() {
     let most = run(&mut whole, 3000);
     let mut half = build();
     run(&mut half, 1500);
-    let at_checkpoint = half.contacts.xi.iter().filter(|x| x.norm2() > 0.0).count()
-        + half.contacts.wall_xi.iter().filter(|x| x.norm2() > 0.0).count();
+    let at_checkpoint = live(&half.contacts.hist) + live(&half.contacts.wall_hist);
     let mut resumed: SphereSystem = serde_json::from_str(&serde_json::to_string(&half).unwrap()).unwrap();
     run(&mut resumed, 1500);
     assert_eq!(
@@ -316,6 +362,7 @@ fn checkpoint_with_clumps_round_trips() {
         serde_json::to_string(&whole).unwrap()
     );
     println!("contacts carrying history: {at_checkpoint} at the checkpoint, at most {most}");
-    // Measured: 3 at the checkpoint, at most 4.
-    assert!(at_checkpoint >= 2 && most >= 3, "{at_checkpoint} {most}");
+    // Measured: 2 at the checkpoint, at most 4; what the test needs is a loaded spring carried
+    // across the checkpoint.
+    assert!(at_checkpoint >= 1 && most >= 3, "{at_checkpoint} {most}");
 }

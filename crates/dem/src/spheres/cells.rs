@@ -21,9 +21,12 @@ pub struct CellList3 {
 }
 
 impl CellList3 {
-    /// Pairs (i < j, sorted) of spheres closer than r_i + r_j + skin (centre distance, minimum
-    /// image on periodic axes), leaving out pairs of the same clump (`owner`, [`FREE`] for a
-    /// free sphere; an empty slice: every sphere free).
+    /// Into `pairs` (cleared first): the pairs (i < j, sorted) of spheres closer than
+    /// r_i + r_j + range(r_i, r_j) + skin (centre distance, minimum image on periodic axes),
+    /// leaving out pairs of the same clump (`owner`, [`FREE`] for a free sphere; an empty slice:
+    /// every sphere free). `range` is the contact law's reach beyond touching
+    /// ([`super::SphereLaw::range`]). A sphere outside the box on an open axis is refused.
+    #[allow(clippy::too_many_arguments)]
     pub fn build_pairs(
         &mut self,
         dom: &Domain3,
@@ -31,10 +34,27 @@ impl CellList3 {
         r: &[f64],
         owner: &[u32],
         skin: f64,
-    ) -> Result<Vec<[u32; 2]>, SphereError> {
+        range: impl Fn(f64, f64) -> f64,
+        pairs: &mut Vec<[u32; 2]>,
+    ) -> Result<(), SphereError> {
+        pairs.clear();
         let n = pos.len();
+        for (k, &p) in pos.iter().enumerate() {
+            for axis in (0..3).filter(|&a| !dom.periodic[a]) {
+                let (v, lo, hi) = (p.component(axis), dom.lo.component(axis), dom.hi.component(axis));
+                if !(v >= lo && v < hi) {
+                    return Err(SphereError::OutsideBox {
+                        sphere: k,
+                        axis,
+                        value: v,
+                        lo,
+                        hi,
+                    });
+                }
+            }
+        }
         let rmax = r.iter().copied().fold(0.0, f64::max);
-        let cut = 2.0 * rmax + skin;
+        let cut = 2.0 * rmax + range(rmax, rmax) + skin;
         let size = dom.size();
         let mut nc = [1usize; 3];
         for (k, nk) in nc.iter_mut().enumerate() {
@@ -105,7 +125,6 @@ impl CellList3 {
             }
             (out, m)
         };
-        let mut pairs = Vec::new();
         for i in 0..n {
             let c = self.cell[i] as usize;
             let (cx, cy, cz) = (c % nc[0], (c / nc[0]) % nc[1], c / (nc[0] * nc[1]));
@@ -118,13 +137,14 @@ impl CellList3 {
                 for &y in &ys[..my] {
                     for &x in &xs[..mx] {
                         let cc = (z * nc[1] + y) * nc[0] + x;
-                        let range = self.cell_start[cc] as usize..self.cell_start[cc + 1] as usize;
-                        for &j in &self.sorted[range] {
+                        let members = self.cell_start[cc] as usize..self.cell_start[cc + 1] as usize;
+                        for &j in &self.sorted[members] {
                             if (j as usize) <= i || same_clump(owner, i, j as usize) {
                                 continue;
                             }
                             let d = dom.min_image(pos[j as usize] - pi);
-                            let rc = ri + r[j as usize] + skin;
+                            let rj = r[j as usize];
+                            let rc = ri + rj + range(ri, rj) + skin;
                             if d.norm2() < rc * rc {
                                 self.nb.push(j);
                             }
@@ -135,7 +155,7 @@ impl CellList3 {
             self.nb.sort_unstable();
             pairs.extend(self.nb.iter().map(|&j| [i as u32, j]));
         }
-        Ok(pairs)
+        Ok(())
     }
 }
 
@@ -145,8 +165,9 @@ fn same_clump(owner: &[u32], i: usize, j: usize) -> bool {
     !owner.is_empty() && owner[i] != FREE && owner[i] == owner[j]
 }
 
-/// Brute-force reference (all pairs), for tests of the cell list.
-pub fn brute_force_pairs(dom: &Domain3, pos: &[Vec3], r: &[f64], owner: &[u32], skin: f64) -> Vec<[u32; 2]> {
+/// Brute-force reference (all pairs, no range), for the test of the cell list.
+#[cfg(test)]
+fn brute_force_pairs(dom: &Domain3, pos: &[Vec3], r: &[f64], owner: &[u32], skin: f64) -> Vec<[u32; 2]> {
     let mut out = Vec::new();
     for i in 0..pos.len() {
         for j in i + 1..pos.len() {
@@ -168,6 +189,10 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_xoshiro::Xoshiro256PlusPlus;
 
+    fn no_range(_: f64, _: f64) -> f64 {
+        0.0
+    }
+
     #[test]
     fn cell_list_matches_brute_force_for_every_periodicity() {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(19);
@@ -186,7 +211,9 @@ mod tests {
         for mask in 0..8u8 {
             let periodic = [mask & 1 != 0, mask & 2 != 0, mask & 4 != 0];
             let dom = Domain3::new(Vec3::ZERO, hi, periodic).unwrap();
-            let got = cl.build_pairs(&dom, &pos, &r, &[], 0.01).unwrap();
+            let mut got = Vec::new();
+            cl.build_pairs(&dom, &pos, &r, &[], 0.01, no_range, &mut got)
+                .unwrap();
             let want = brute_force_pairs(&dom, &pos, &r, &[], 0.01);
             assert!(!want.is_empty());
             assert_eq!(got, want, "periodic {periodic:?}");
@@ -195,7 +222,8 @@ mod tests {
             let owner: Vec<u32> = (0..600u32)
                 .map(|k| if k % 4 == 3 { FREE } else { k / 12 })
                 .collect();
-            let got = cl.build_pairs(&dom, &pos, &r, &owner, 0.01).unwrap();
+            cl.build_pairs(&dom, &pos, &r, &owner, 0.01, no_range, &mut got)
+                .unwrap();
             let want_c = brute_force_pairs(&dom, &pos, &r, &owner, 0.01);
             assert_eq!(got, want_c, "periodic {periodic:?}, clumps");
             let inside = want
@@ -203,12 +231,46 @@ mod tests {
                 .filter(|p| owner[p[0] as usize] != FREE && owner[p[0] as usize] == owner[p[1] as usize])
                 .count();
             assert!(inside > 0 && want_c.len() + inside == want.len());
+            // A law with a range of 0.3 (r_i + r_j) reaches as far as a skin that large.
+            let ranged = |a: f64, b: f64| 0.3 * (a + b);
+            cl.build_pairs(&dom, &pos, &r, &[], 0.01, ranged, &mut got)
+                .unwrap();
+            let want_r: Vec<[u32; 2]> = brute_force_pairs(&dom, &pos, &r, &[], 0.3)
+                .into_iter()
+                .filter(|&[i, j]| {
+                    let (i, j) = (i as usize, j as usize);
+                    let rc = 1.3 * (r[i] + r[j]) + 0.01;
+                    dom.min_image(pos[j] - pos[i]).norm2() < rc * rc
+                })
+                .collect();
+            assert!(want_r.len() > want.len());
+            assert_eq!(got, want_r, "periodic {periodic:?}, with a range");
         }
         // An axis too short for a unique minimum image is refused.
         let dom = Domain3::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.2), [false, false, true]).unwrap();
-        let err = cl.build_pairs(&dom, &pos, &r, &[], 0.01).unwrap_err();
+        let err = cl
+            .build_pairs(&dom, &pos, &r, &[], 0.01, no_range, &mut Vec::new())
+            .unwrap_err();
         assert!(
             matches!(err, SphereError::PeriodicBoxTooSmall { axis: 2, .. }),
+            "{err}"
+        );
+        // A sphere outside the box on an open axis is refused, naming it.
+        let dom = Domain3::new(Vec3::ZERO, hi, [true, false, true]).unwrap();
+        let mut out = pos.clone();
+        out[7].y = 0.6;
+        let err = cl
+            .build_pairs(&dom, &out, &r, &[], 0.01, no_range, &mut Vec::new())
+            .unwrap_err();
+        assert!(
+            matches!(
+                err,
+                SphereError::OutsideBox {
+                    sphere: 7,
+                    axis: 1,
+                    ..
+                }
+            ),
             "{err}"
         );
     }

@@ -85,7 +85,13 @@ impl ClumpTemplate {
                 });
             }
         }
-        let n = n.max(4);
+        if n < 4 {
+            return Err(SphereError::BadParameter {
+                name: "clump quadrature nodes per piece",
+                value: n as f64,
+                why: "the union quadrature needs at least 4 nodes per piece (default DEFAULT_NODES = 48)",
+            });
+        }
         let sp = &self.spheres;
         // x breakpoints: sphere extents, and the x-extent of every pairwise intersection circle.
         let mut xb: Vec<f64> = Vec::new();
@@ -222,19 +228,34 @@ fn for_pieces(breaks: &mut Vec<f64>, n: usize, mut f: impl FnMut(f64, f64)) {
     }
 }
 
-/// The body frame of a clump: principal moments (at density `rho`), the rotation from the body
-/// frame to the template frame, and the members' body-frame offsets.
+/// The body frame of a clump template at a density: principal moments, the rotation from the
+/// body frame to the template frame, and the members' body-frame offsets and radii. Built once
+/// per template ([`BodyFrame::of`], the union quadrature) and passed to every
+/// [`super::SphereSystem::add_clump`] of that template.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BodyFrame {
+    /// Density of the clump (kg/m³).
+    pub density: f64,
     pub mass: f64,
     pub inertia: Vec3,
     /// Body frame → template frame.
     pub to_template: UnitQuaternion<f64>,
     pub offsets: Vec<Vec3>,
+    /// The members' radii (m), in the template's order.
+    pub radii: Vec<f64>,
 }
 
 impl BodyFrame {
+    /// The body frame of `t` at density `rho` (kg/m³), the union's mass properties integrated
+    /// with `nodes` per piece ([`ClumpTemplate::union_props`], e.g. [`DEFAULT_NODES`]).
     pub fn of(t: &ClumpTemplate, rho: f64, nodes: usize) -> Result<Self, SphereError> {
+        if !(rho > 0.0 && rho.is_finite()) {
+            return Err(SphereError::BadParameter {
+                name: "clump density",
+                value: rho,
+                why: "it must be positive and finite (kg/m^3)",
+            });
+        }
         let p = t.union_props(nodes)?;
         let i = Matrix3::from_fn(|r, c| rho * p.inertia[r][c]);
         let eig = SymmetricEigen::new(i);
@@ -247,13 +268,15 @@ impl BodyFrame {
         let offsets = t
             .spheres
             .iter()
-            .map(|&(c, _)| from_na(to_template.inverse_transform_vector(&to_na(c - p.centroid))))
+            .map(|&(c, _)| (c - p.centroid).rotated_back_by(&to_template))
             .collect();
         Ok(Self {
+            density: rho,
             mass: rho * p.volume,
             inertia: Vec3::new(eig.eigenvalues[0], eig.eigenvalues[1], eig.eigenvalues[2]),
             to_template,
             offsets,
+            radii: t.spheres.iter().map(|&(_, r)| r).collect(),
         })
     }
 }
@@ -303,9 +326,9 @@ impl Clumps {
     /// Angular velocity of clump `c` in the world frame: Q I⁻¹ Qᵀ L.
     pub fn omega(&self, c: usize) -> Vec3 {
         let q = self.orientation(c);
-        let lb = q.inverse_transform_vector(&to_na(self.ang_mom[c]));
+        let lb = self.ang_mom[c].rotated_back_by(&q);
         let i = self.inertia[c];
-        from_na(q.transform_vector(&Vector3::new(lb.x / i.x, lb.y / i.y, lb.z / i.z)))
+        Vec3::new(lb.x / i.x, lb.y / i.y, lb.z / i.z).rotated_by(&q)
     }
     /// Rotational kinetic energy of clump `c`, (1/2) L·ω.
     pub fn rotational_energy(&self, c: usize) -> f64 {
@@ -319,7 +342,7 @@ impl Clumps {
 /// angular momentum `l` (the splitting in the module docs); returns the new unit quaternion.
 pub fn free_rotation(q: UnitQuaternion<f64>, l: Vec3, inertia: Vec3, dt: f64) -> UnitQuaternion<f64> {
     let mut q = q;
-    let mut lb = q.inverse_transform_vector(&to_na(l));
+    let mut lb: Vector3<f64> = l.rotated_back_by(&q).into();
     let axes = [Vector3::x_axis(), Vector3::y_axis(), Vector3::z_axis()];
     let moments = [inertia.x, inertia.y, inertia.z];
     for (k, tau) in [(0, 0.5), (1, 0.5), (2, 1.0), (1, 0.5), (0, 0.5)] {
@@ -330,16 +353,6 @@ pub fn free_rotation(q: UnitQuaternion<f64>, l: Vec3, inertia: Vec3, dt: f64) ->
     }
     q.renormalize();
     q
-}
-
-#[inline]
-pub(crate) fn to_na(v: Vec3) -> Vector3<f64> {
-    Vector3::new(v.x, v.y, v.z)
-}
-
-#[inline]
-pub(crate) fn from_na(v: Vector3<f64>) -> Vec3 {
-    Vec3::new(v.x, v.y, v.z)
 }
 
 /// A quaternion as the state stores it, (w, x, y, z).

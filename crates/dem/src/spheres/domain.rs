@@ -1,6 +1,6 @@
-//! The simulation box of the sphere engine: periodic or open per axis. Open axes only bound the
-//! cell grid (walls do the confining); spheres outside it are clamped into the border cells,
-//! which keeps the cell list exact.
+//! The simulation box of the sphere engine: periodic or open per axis. Open axes bound the cell
+//! grid (walls do the confining); a sphere found outside the box on an open axis is refused by
+//! the cell list ([`super::SphereError::OutsideBox`]) rather than piled into a border cell.
 
 use super::error::SphereError;
 use crate::vector::{Vec3, Vector};
@@ -68,9 +68,11 @@ impl Domain3 {
                     *x -= lk;
                 }
                 if !(*x >= lo && *x < hi) && x.is_finite() {
-                    // More than one box length away (not reached by a stable run).
+                    // More than one box length away (not reached by a stable run), or a shift
+                    // that rounded past an end.
                     *x -= lk * ((*x - lo) / lk).floor();
-                    if *x >= hi {
+                    if !(*x >= lo && *x < hi) {
+                        // Within rounding of lo or hi, the same point of the periodic axis.
                         *x = lo;
                     }
                 }
@@ -100,5 +102,13 @@ mod tests {
             "{far:?}"
         );
         assert!(Domain3::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0), [false; 3]).is_err());
+        // One ulp below lo: lo - ulp + L rounds to hi, and the old `hi -> lo` fallback shifted
+        // it to lo - ulp again, outside the box (found by a random search).
+        let (lo, hi) = (0.7355621288699867, 3.6571500849874647);
+        let d = Domain3::new(Vec3::new(lo, lo, lo), Vec3::new(hi, hi, hi), [true; 3]).unwrap();
+        for x in [0.7355621288699866, hi, 2.0 * lo - hi, -40.0] {
+            let w = d.wrap(Vec3::new(x, x, x)).x;
+            assert!((lo..hi).contains(&w), "{x} -> {w}");
+        }
     }
 }

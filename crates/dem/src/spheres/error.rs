@@ -11,12 +11,15 @@ pub enum SphereError {
         why: &'static str,
     },
     #[error(
-        "time step dt = {dt:e} s is above the Rayleigh time step {rayleigh:e} s of the smallest sphere \
-         (t_R = pi r sqrt(rho/G) / (0.1631 nu + 0.8766)); Hertzian contacts are unstable beyond it — \
-         take dt at most 0.2 t_R = {:e} s",
-        0.2 * rayleigh
+        "time step dt = {dt:e} s is above the contact law's limit {limit:e} s at sphere {sphere} \
+         ({bound}); take dt at most {limit:e} s"
     )]
-    TimeStepTooLarge { dt: f64, rayleigh: f64 },
+    TimeStepTooLarge {
+        dt: f64,
+        limit: f64,
+        sphere: usize,
+        bound: &'static str,
+    },
     #[error("time step dt = {dt:e} s must be a positive, finite number of seconds")]
     BadTimeStep { dt: f64 },
     #[error(
@@ -29,6 +32,29 @@ pub enum SphereError {
          give a smaller box or larger spheres"
     )]
     TooManyCells { cells: usize },
+    #[error(
+        "sphere {sphere} is at {value:e} m on the open axis {axis}, outside the box [{lo:e}, {hi:e}) m: \
+         the cell list would pile such spheres into the border cells; enlarge the box, confine the \
+         spheres with walls, or make the axis periodic"
+    )]
+    OutsideBox {
+        sphere: usize,
+        axis: usize,
+        value: f64,
+        lo: f64,
+        hi: f64,
+    },
+    #[error(
+        "inconsistent sphere state (a corrupt checkpoint or a hand-edited system): {field} is {found}, \
+         expected {expected}; regenerate the checkpoint or fix the field"
+    )]
+    Inconsistent {
+        field: &'static str,
+        found: String,
+        expected: String,
+    },
+    #[error("clump {clump}: non-finite position, velocity or spin given; pass finite values")]
+    NonFiniteClump { clump: usize },
     #[error(
         "sphere {sphere}: non-finite state at step {step} (position, velocity or spin is NaN/inf); \
          a non-finite initial state or a blown-up run — check the initial state, then lower dt"

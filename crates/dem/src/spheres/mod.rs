@@ -1,36 +1,40 @@
-//! 3D spheres: a discrete-element engine for solid spheres and rigid clumps of spheres with
-//! Hertz-Mindlin contacts (issue 19 item 1, first slice; Leonardi et al. 2014 Sect. 3 and Ness
-//! et al. 2017 need 3D grains).
+//! 3D spheres: a discrete-element engine for solid spheres and rigid clumps of spheres (issue 19
+//! item 1; Leonardi et al. 2014 Sect. 3 and Ness et al. 2017 need 3D grains).
 //!
 //! Built as the 2D engine is: the state is plain data ([`SphereSystem`]: spheres, plane walls,
-//! the Verlet list with its contact histories, the clock; serialisable, a checkpoint resumes bit
-//! for bit), the [`SphereStepper`] is scratch, the contact law ([`HertzMindlin`], `law.rs`) is a
-//! small pure kernel with its equations in its docs. No file I/O.
+//! the Verlet list with its contact histories, the clock; serialisable, checked when read, a
+//! checkpoint resumes bit for bit), the [`SphereStepper`] is scratch and generic over the
+//! contact law ([`SphereLaw`]: its range beyond contact, its history, its stable step), callers
+//! add forces through a [`SphereForceHook`]. No file I/O.
 //!
 //! - `domain.rs`: the box, periodic on any axis (minimum image);
-//! - `cells.rs`: linked-cell broad phase building a sorted Verlet list with a skin;
-//! - `law.rs`: Hertz normal force, Mindlin tangential spring with history, Coulomb cap,
-//!   restitution damping (Tsuji; LIGGGHTS `hertz tangential history`);
+//! - `cells.rs`: linked-cell broad phase building a sorted Verlet list with a skin, reaching the
+//!   law's range;
+//! - `law/`: the contact-law seam and the laws ([`HertzMindlinSpring`]);
 //! - `clump.rs`: rigid clumps (mass properties of the union of spheres, principal axes, the
 //!   body-frame free rotation);
-//! - `stepper.rs`: velocity Verlet, serial (results are independent of the rayon thread count
-//!   because nothing here runs in parallel yet).
+//! - `hook.rs`: user forces;
+//! - `validate.rs`: the consistency check of a state (checkpoints are user input);
+//! - `stepper.rs`: velocity Verlet, serial.
 //!
 //! Validated against Chung & Ooi (2011) benchmarks 1-4 (`crates/dem/tests/chung_ooi.rs`,
-//! `docs/dem3d.md`); clumps in `crates/dem/tests/clumps.rs`. Not yet here: lubrication,
-//! parallel passes, per-sphere materials.
+//! `docs/dem3d.md`); clumps in `crates/dem/tests/clumps.rs`. Not yet here: parallel passes,
+//! per-sphere materials.
 
 pub mod cells;
 pub mod clump;
 pub mod domain;
 pub mod error;
+pub mod hook;
 pub mod law;
 pub mod stepper;
 pub mod system;
+pub mod validate;
 
-pub use clump::{ClumpTemplate, Clumps};
+pub use clump::{BodyFrame, ClumpTemplate, Clumps};
 pub use domain::Domain3;
 pub use error::SphereError;
-pub use law::{Elastic, HertzMindlin, Surface};
-pub use stepper::{SphereStepParams, SphereStepper};
+pub use hook::SphereForceHook;
+pub use law::{Elastic, HertzMindlinSpring, Interaction, Response, SphereLaw, Surface, TimeStepLimit};
+pub use stepper::{SphereStepParams, SphereStepper, max_time_step};
 pub use system::{FREE, PlaneWall, SphereContacts, SphereSystem, Spheres};

@@ -1,19 +1,23 @@
 //! The time step of the sphere engine: velocity Verlet for translation and rotation (Verlet
 //! 1967; Allen & Tildesley, "Computer Simulation of Liquids", Sect. 3.2), the same scheme as the
 //! 2D engine: half kick with the last forces, drift, Verlet-list check, forces at the new
-//! positions with the half-step velocities, closing half kick.
+//! positions with the half-step velocities, closing half kick. Generic over the contact law
+//! ([`SphereLaw`], monomorphised: its `force` inlines into the pair loop); user forces through a
+//! [`SphereForceHook`].
 //!
-//! Serial in this first version. Determinism: the pair list is sorted (i < j), every pair that
-//! is not in contact is skipped (adds nothing) and wall contacts follow in wall order, so each
-//! sphere's force is summed in an order fixed by the set of contacts alone; and the list's
-//! reference positions live in the state, so a resumed run rebuilds the list at the same steps
-//! and continues bit for bit.
+//! Serial: nothing here runs in parallel, so results do not depend on the thread count.
+//! Determinism: the pair list is sorted (i < j), every pair beyond the law's range is skipped
+//! (adds nothing) and wall contacts follow in wall order, so each sphere's force is summed in an
+//! order fixed by the set of interactions alone; and the list's reference positions live in the
+//! state, so a resumed run rebuilds the list at the same steps and continues bit for bit.
 
 use super::cells::CellList3;
-use super::clump::{Clumps, free_rotation, from_na, quat_array, to_na};
+use super::clump::{Clumps, free_rotation, quat_array};
 use super::error::SphereError;
-use super::law::{ContactKin, HertzMindlin, hertz_mindlin_force};
+use super::hook::{NoHook, SphereForceHook, user_forces};
+use super::law::{Interaction, SphereLaw, TimeStepLimit};
 use super::system::{FREE, SphereSystem, Spheres};
+use crate::history::Histories;
 use crate::neighbor::carry_history_into;
 use crate::vector::{Vec3, Vector};
 use serde::{Deserialize, Serialize};
@@ -41,37 +45,51 @@ impl SphereStepParams {
     }
 }
 
-/// Scratch for stepping a [`SphereSystem`] (nothing here is state).
-#[derive(Default, Debug)]
-pub struct SphereStepper {
+/// Scratch for stepping a [`SphereSystem`] under the law `L` (nothing here is state).
+#[derive(Debug)]
+pub struct SphereStepper<L: SphereLaw> {
     cells: CellList3,
-    new_xi: Vec<Vec3>,
-    /// The (dt, law, sphere count) last checked against the Rayleigh step.
-    checked: Option<(f64, HertzMindlin, usize)>,
+    new_pairs: Vec<[u32; 2]>,
+    new_hist: Histories,
+    /// The (dt, law, sphere count) last checked.
+    checked: Option<(f64, L, usize)>,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
 
-impl SphereStepper {
+impl<L: SphereLaw> Default for SphereStepper<L> {
+    fn default() -> Self {
+        Self {
+            cells: CellList3::default(),
+            new_pairs: Vec::new(),
+            new_hist: Histories::default(),
+            checked: None,
+            rebuilds: 0,
+        }
+    }
+}
+
+/// The smallest time-step limit of `law` over the spheres of `sys`, and the sphere that sets it
+/// (`None` with no spheres).
+pub fn max_time_step<L: SphereLaw>(law: &L, sys: &SphereSystem) -> Option<(usize, TimeStepLimit)> {
+    let s = &sys.spheres;
+    (0..s.len())
+        .map(|k| (k, law.max_time_step(s.radius[k], s.mass[k])))
+        .reduce(|a, b| if b.1.dt < a.1.dt { b } else { a })
+}
+
+impl<L: SphereLaw> SphereStepper<L> {
     pub fn new() -> Self {
         Self::default()
     }
 
-    /// The smallest Rayleigh time step over the spheres (s); infinite with no spheres.
-    pub fn rayleigh_time_step(sys: &SphereSystem, law: &HertzMindlin) -> f64 {
-        let s = &sys.spheres;
-        (0..s.len())
-            .map(|k| law.rayleigh_time_step(s.radius[k], s.mass[k]))
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    fn check(
-        &mut self,
-        p: &SphereStepParams,
-        law: &HertzMindlin,
-        sys: &SphereSystem,
-    ) -> Result<(), SphereError> {
-        if self.checked == Some((p.dt, *law, sys.spheres.len())) {
+    fn check(&mut self, p: &SphereStepParams, law: &L, sys: &SphereSystem) -> Result<(), SphereError> {
+        let n = sys.spheres.len();
+        if self
+            .checked
+            .as_ref()
+            .is_some_and(|(dt, l, m)| *dt == p.dt && l == law && *m == n)
+        {
             return Ok(());
         }
         if !(p.dt > 0.0 && p.dt.is_finite()) {
@@ -92,22 +110,40 @@ impl SphereStepper {
             });
         }
         law.check()?;
-        let rayleigh = Self::rayleigh_time_step(sys, law);
-        if p.dt > rayleigh {
-            return Err(SphereError::TimeStepTooLarge { dt: p.dt, rayleigh });
+        sys.validate()?;
+        if let Some((sphere, limit)) = max_time_step(law, sys)
+            && p.dt > limit.dt
+        {
+            return Err(SphereError::TimeStepTooLarge {
+                dt: p.dt,
+                limit: limit.dt,
+                sphere,
+                bound: limit.bound,
+            });
         }
-        self.checked = Some((p.dt, *law, sys.spheres.len()));
+        self.checked = Some((p.dt, law.clone(), n));
         Ok(())
     }
 
     /// Advance `sys` by one step of `p.dt` under `law`.
-    pub fn step(
+    pub fn step(&mut self, p: &SphereStepParams, law: &L, sys: &mut SphereSystem) -> Result<(), SphereError> {
+        self.step_with(p, law, sys, &mut NoHook)
+    }
+
+    /// Advance `sys` by one step of `p.dt` under `law`, with the user forces of `hook`.
+    pub fn step_with(
         &mut self,
         p: &SphereStepParams,
-        law: &HertzMindlin,
+        law: &L,
         sys: &mut SphereSystem,
+        hook: &mut impl SphereForceHook,
     ) -> Result<(), SphereError> {
         self.check(p, law, sys)?;
+        if sys.step == 0 {
+            // Prime F(0): the opening half kick needs the forces of the initial state.
+            self.refresh_list(p.skin, law, sys)?;
+            self.forces(p, law, sys, hook);
+        }
         let dt = p.dt;
         let h = 0.5 * dt;
         let dom = sys.domain;
@@ -133,9 +169,9 @@ impl SphereStepper {
         for w in &mut sys.walls {
             w.point += w.vel * dt;
         }
-        self.refresh_list(p.skin, sys)?;
-        self.forces(p, law, sys);
-        gather_clumps(sys, p.gravity);
+        sys.time += dt;
+        self.refresh_list(p.skin, law, sys)?;
+        self.forces(p, law, sys, hook);
         // Closing half kick.
         for k in 0..n {
             if sys.is_free(k) {
@@ -150,7 +186,6 @@ impl SphereStepper {
             c.ang_mom[k] += c.torque[k] * h;
         }
         place_members(sys, false);
-        sys.time += dt;
         sys.step += 1;
         let s = &sys.spheres;
         if let Some(k) =
@@ -166,12 +201,12 @@ impl SphereStepper {
 
     /// Rebuild the Verlet list if it is missing or a sphere has moved more than skin/2 since
     /// it was built, carrying each pair's history onto the new list.
-    fn refresh_list(&mut self, skin: f64, sys: &mut SphereSystem) -> Result<(), SphereError> {
+    fn refresh_list(&mut self, skin: f64, law: &L, sys: &mut SphereSystem) -> Result<(), SphereError> {
         let dom = sys.domain;
         let s = &sys.spheres;
         let c = &mut sys.contacts;
         let n = s.len();
-        let fresh = c.list_ref.len() == n && c.xi.len() == c.pairs.len() && {
+        let fresh = c.list_ref.len() == n && c.hist.len() == c.pairs.len() && {
             let lim = 0.25 * skin * skin;
             s.pos
                 .iter()
@@ -179,114 +214,136 @@ impl SphereStepper {
                 .all(|(&p, &q)| dom.min_image(p - q).norm2() <= lim)
         };
         if !fresh {
-            let pairs = self.cells.build_pairs(&dom, &s.pos, &s.radius, &s.owner, skin)?;
-            self.new_xi.clear();
-            self.new_xi.resize(pairs.len(), Vec3::ZERO);
-            let keep = c.pairs.len().min(c.xi.len());
-            carry_history_into(&c.pairs[..keep], &c.xi[..keep], &pairs, &mut self.new_xi);
-            c.pairs = pairs;
-            std::mem::swap(&mut c.xi, &mut self.new_xi);
+            self.cells.build_pairs(
+                &dom,
+                &s.pos,
+                &s.radius,
+                &s.owner,
+                skin,
+                |a, b| law.range(a, b),
+                &mut self.new_pairs,
+            )?;
+            let new = self.new_hist.conform::<L::History>(self.new_pairs.len());
+            new.fill(L::History::default());
+            let old = c.hist.as_slice::<L::History>().unwrap_or(&[]);
+            let keep = c.pairs.len().min(old.len());
+            carry_history_into(&c.pairs[..keep], &old[..keep], &self.new_pairs, new);
+            std::mem::swap(&mut c.pairs, &mut self.new_pairs);
+            std::mem::swap(&mut c.hist, &mut self.new_hist);
             c.list_ref.clear();
             c.list_ref.extend_from_slice(&s.pos);
             self.rebuilds += 1;
         }
-        let nw = sys.walls.len();
-        if c.wall_xi.len() != n * nw {
-            c.wall_xi.clear();
-            c.wall_xi.resize(n * nw, Vec3::ZERO);
-        }
         Ok(())
     }
 
-    /// Contact forces (pairs in list order, then walls), gravity.
-    fn forces(&mut self, p: &SphereStepParams, law: &HertzMindlin, sys: &mut SphereSystem) {
+    /// Interaction forces (pairs in list order, then walls), gravity, the user's forces; then
+    /// each clump's total.
+    fn forces(
+        &mut self,
+        p: &SphereStepParams,
+        law: &L,
+        sys: &mut SphereSystem,
+        hook: &mut impl SphereForceHook,
+    ) {
         let dom = sys.domain;
         let s = &mut sys.spheres;
         let c = &mut sys.contacts;
         let cl = &sys.clumps;
         let n = s.len();
-        for k in 0..n {
-            s.force[k] = Vec3::ZERO;
-            s.torque[k] = Vec3::ZERO;
-        }
-        let pc = law.pair_coeffs();
-        for (pair, xi) in c.pairs.iter().zip(c.xi.iter_mut()) {
+        s.force.fill(Vec3::ZERO);
+        s.torque.fill(Vec3::ZERO);
+        let hist = c.hist.conform::<L::History>(c.pairs.len());
+        for (pair, h) in c.pairs.iter().zip(hist.iter_mut()) {
             let (i, j) = (pair[0] as usize, pair[1] as usize);
             let d = dom.min_image(s.pos[j] - s.pos[i]);
             let (ri, rj) = (s.radius[i], s.radius[j]);
             let dist2 = d.norm2();
-            let rs = ri + rj;
-            if dist2 >= rs * rs || dist2 == 0.0 {
-                *xi = Vec3::ZERO;
+            let reach = ri + rj + law.range(ri, rj);
+            if dist2 >= reach * reach || dist2 == 0.0 {
+                *h = L::History::default();
                 continue;
             }
             let dist = dist2.sqrt();
             let nrm = d * (1.0 / dist);
-            let delta = rs - dist;
-            // Arms to the contact point, halfway into the overlap (a_i + a_j = distance, so the
-            // pair conserves angular momentum).
+            let delta = ri + rj - dist;
+            // Arms to the contact point, halfway into the overlap (or across the gap): a_i + a_j
+            // = distance, so the pair conserves angular momentum.
             let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
             let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (s.vel[j] + s.omega[j].cross(nrm * -aj));
             let (mi, mj) = (body_mass(s, cl, i), body_mass(s, cl, j));
-            let kin = ContactKin {
+            let it = Interaction {
                 n: nrm,
                 delta,
-                r_eff: ri * rj / rs,
+                r_i: ri,
+                r_j: rj,
+                r_eff: ri * rj / (ri + rj),
                 m_eff: mi * mj / (mi + mj),
                 v_rel,
+                dv: s.vel[i] - s.vel[j],
+                dw: s.omega[i] - s.omega[j],
+                wall: false,
+                dt: p.dt,
             };
-            let (f, _) = hertz_mindlin_force(&pc, &kin, p.dt, xi);
-            s.force[i] += f;
-            s.force[j] -= f;
-            let tq = nrm.cross(f);
-            s.torque[i] += tq * ai;
-            s.torque[j] += tq * aj;
+            let out = law.force(&it, h);
+            s.force[i] += out.f;
+            s.force[j] -= out.f;
+            let tq = nrm.cross(out.f);
+            s.torque[i] += tq * ai + out.torque_i;
+            s.torque[j] += tq * aj + out.torque_j;
         }
         let nw = sys.walls.len();
+        let wall_hist = c.wall_hist.conform::<L::History>(n * nw);
         if nw > 0 {
-            let wc = law.wall_coeffs();
             for k in 0..n {
                 for (w, wall) in sys.walls.iter().enumerate() {
-                    let xi = &mut c.wall_xi[k * nw + w];
+                    let h = &mut wall_hist[k * nw + w];
                     let r = s.radius[k];
                     let gap = (s.pos[k] - wall.point).dot(wall.normal);
-                    if gap >= r {
-                        *xi = Vec3::ZERO;
+                    if gap >= r + law.wall_range(r) {
+                        *h = L::History::default();
                         continue;
                     }
                     let nrm = -wall.normal;
                     let delta = r - gap;
                     let a = r - 0.5 * delta;
-                    let v_rel = s.vel[k] + s.omega[k].cross(nrm * a) - wall.vel;
-                    let kin = ContactKin {
+                    let it = Interaction {
                         n: nrm,
                         delta,
+                        r_i: r,
+                        r_j: f64::INFINITY,
                         r_eff: r,
                         m_eff: body_mass(s, cl, k),
-                        v_rel,
+                        v_rel: s.vel[k] + s.omega[k].cross(nrm * a) - wall.vel,
+                        dv: s.vel[k] - wall.vel,
+                        dw: s.omega[k],
+                        wall: true,
+                        dt: p.dt,
                     };
-                    let (f, _) = hertz_mindlin_force(&wc, &kin, p.dt, xi);
-                    s.force[k] += f;
-                    s.torque[k] += nrm.cross(f) * a;
+                    let out = law.force(&it, h);
+                    s.force[k] += out.f;
+                    s.torque[k] += nrm.cross(out.f) * a + out.torque_i;
                 }
             }
         }
         if p.gravity != Vec3::ZERO {
             for k in 0..n {
-                if s.owner.get(k).is_none_or(|&o| o == FREE) {
+                if s.owner[k] == FREE {
                     s.force[k] += p.gravity * s.mass[k];
                 }
             }
         }
+        user_forces(hook, sys.time, sys);
+        gather_clumps(sys, p.gravity);
     }
 }
 
 /// The mass that moves with sphere `k`: its own, or its clump's.
 #[inline]
 fn body_mass(s: &Spheres, cl: &Clumps, k: usize) -> f64 {
-    match s.owner.get(k) {
-        Some(&o) if o != FREE => cl.mass[o as usize],
-        _ => s.mass[k],
+    match s.owner[k] {
+        FREE => s.mass[k],
+        o => cl.mass[o as usize],
     }
 }
 
@@ -299,7 +356,7 @@ fn place_members(sys: &mut SphereSystem, positions: bool) {
         let q = c.orientation(k);
         let w = c.omega(k);
         for (m, b) in c.members_of(k) {
-            let arm = from_na(q.transform_vector(&to_na(b)));
+            let arm = b.rotated_by(&q);
             if positions {
                 s.pos[m] = dom.wrap(c.pos[k] + arm);
             }
@@ -319,7 +376,7 @@ fn gather_clumps(sys: &mut SphereSystem, gravity: Vec3) {
         let r = c.start[k] as usize..c.start[k + 1] as usize;
         for (&m, &b) in c.members[r.clone()].iter().zip(&c.offset[r]) {
             let m = m as usize;
-            let arm = from_na(q.transform_vector(&to_na(b)));
+            let arm = b.rotated_by(&q);
             f += s.force[m];
             t += arm.cross(s.force[m]) + s.torque[m];
         }

@@ -2,11 +2,14 @@
 //! Verlet list with its contact histories, the clock. A checkpoint is this struct written with
 //! `serde_json` (`float_roundtrip`); a run resumed from it continues bit for bit, because every
 //! quantity the step reads — the last forces, the pair list and the positions it was built at —
-//! is here, and the stepper holds only scratch.
+//! is here, and the stepper holds only scratch. A checkpoint is user input: it is checked on
+//! the way in (`validate.rs`).
 
-use super::clump::{BodyFrame, ClumpTemplate, Clumps, from_na, quat_array, to_na};
+use super::clump::{BodyFrame, Clumps, quat_array};
 use super::domain::Domain3;
 use super::error::SphereError;
+use super::validate::RawSphereSystem;
+use crate::history::Histories;
 use crate::vector::{Vec3, Vector};
 use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
@@ -26,7 +29,7 @@ pub struct Spheres {
     pub mass: Vec<f64>,
     /// Moment of inertia about the centre, (2/5) m r² for a solid sphere.
     pub inertia: Vec<f64>,
-    /// The clump a sphere belongs to, or [`FREE`].
+    /// The clump a sphere belongs to, or [`FREE`] (absent in older checkpoints: all free).
     #[serde(default)]
     pub owner: Vec<u32>,
 }
@@ -75,21 +78,23 @@ impl PlaneWall {
     }
 }
 
-/// The Verlet pair list and the contact histories (tangential springs ξ).
+/// The Verlet pair list and the contact histories, in the contact law's own record type
+/// ([`super::SphereLaw::History`]; e.g. the tangential spring ξ of [`super::HertzMindlinSpring`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SphereContacts {
     /// Candidate pairs (i < j), sorted.
     pub pairs: Vec<[u32; 2]>,
-    /// Tangential spring of each pair (zero when not in contact).
-    pub xi: Vec<Vec3>,
-    /// Tangential spring of each sphere-wall contact, index `sphere * n_walls + wall`.
-    pub wall_xi: Vec<Vec3>,
+    /// History of each pair (fresh when out of the law's range).
+    pub hist: Histories,
+    /// History of each sphere-wall contact, index `sphere * n_walls + wall`.
+    pub wall_hist: Histories,
     /// Sphere positions when the list was built (the rebuild test reads them).
     pub list_ref: Vec<Vec3>,
 }
 
 /// A sphere assembly: state only (see the module docs).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawSphereSystem")]
 pub struct SphereSystem {
     pub domain: Domain3,
     pub spheres: Spheres,
@@ -161,42 +166,27 @@ impl SphereSystem {
         Ok(s.len() - 1)
     }
 
-    /// Add a rigid clump of `template`'s spheres (density `rho`, mass properties of their union
-    /// by [`ClumpTemplate::union_props`] with `nodes` per piece, e.g.
-    /// [`super::clump::DEFAULT_NODES`]), its centre of mass at
-    /// `pos`, turned by `orientation` from the template's frame, moving at `vel`, spinning at
-    /// `omega`; returns the clump's index.
-    #[allow(clippy::too_many_arguments)]
+    /// Add a rigid clump of the template whose body frame is `frame` ([`BodyFrame::of`], built
+    /// once per template and density), its centre of mass at `pos`, turned by `orientation`
+    /// from the template's frame, moving at `vel`, spinning at `omega`; returns the clump's
+    /// index.
     pub fn add_clump(
         &mut self,
-        template: &ClumpTemplate,
+        frame: &BodyFrame,
         pos: Vec3,
         orientation: UnitQuaternion<f64>,
         vel: Vec3,
         omega: Vec3,
-        rho: f64,
-        nodes: usize,
     ) -> Result<usize, SphereError> {
-        if !(rho > 0.0 && rho.is_finite()) {
-            return Err(SphereError::BadParameter {
-                name: "clump density",
-                value: rho,
-                why: "it must be positive and finite (kg/m^3)",
-            });
-        }
-        if ![pos, vel, omega].iter().all(|v| v.is_finite()) {
-            return Err(SphereError::NonFinite {
-                sphere: self.spheres.len(),
-                step: self.step,
-            });
-        }
-        let frame = BodyFrame::of(template, rho, nodes)?;
-        let q = orientation * frame.to_template;
         let c = self.clumps.len();
+        if ![pos, vel, omega].iter().all(|v| v.is_finite()) {
+            return Err(SphereError::NonFiniteClump { clump: c });
+        }
+        let q = orientation * frame.to_template;
         let first = self.spheres.len();
-        for (k, (&b, &(_, r))) in frame.offsets.iter().zip(&template.spheres).enumerate() {
-            let arm = from_na(q.transform_vector(&to_na(b)));
-            self.add_sphere(pos + arm, vel + omega.cross(arm), omega, r, rho)?;
+        for (k, (&b, &r)) in frame.offsets.iter().zip(&frame.radii).enumerate() {
+            let arm = b.rotated_by(&q);
+            self.add_sphere(pos + arm, vel + omega.cross(arm), omega, r, frame.density)?;
             self.spheres.owner[first + k] = c as u32;
         }
         let cl = &mut self.clumps;
@@ -208,8 +198,8 @@ impl SphereSystem {
         cl.start.push(cl.members.len() as u32);
         let i = frame.inertia;
         // L = Q I Qᵀ ω.
-        let wb = q.inverse_transform_vector(&to_na(omega));
-        let l = from_na(q.transform_vector(&nalgebra::Vector3::new(i.x * wb.x, i.y * wb.y, i.z * wb.z)));
+        let wb = omega.rotated_back_by(&q);
+        let l = Vec3::new(i.x * wb.x, i.y * wb.y, i.z * wb.z).rotated_by(&q);
         cl.pos.push(self.domain.wrap(pos));
         cl.vel.push(vel);
         cl.quat.push(quat_array(&q));
