@@ -32,6 +32,29 @@ fn a_typo_in_lbdem_isa_is_refused_before_anything_runs() {
     assert!(!out.exists(), "a refused run left {}", out.display());
 }
 
+/// A value that is not UTF-8 names no level either: refused, not taken as unset.
+#[cfg(unix)]
+#[test]
+fn a_non_utf8_lbdem_isa_is_refused() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("never");
+    let o = Command::new(env!("CARGO_BIN_EXE_lbdem"))
+        .args([
+            "simulate",
+            "scenes/dry-settle.toml",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .env("LBDEM_ISA", std::ffi::OsStr::from_bytes(b"v\xff4"))
+        .output()
+        .expect("run lbdem");
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("LBDEM_ISA"), "{err}");
+    assert!(!out.exists(), "a refused run left {}", out.display());
+}
+
 #[test]
 fn the_portable_cap_is_taken_or_its_lack_of_effect_named() {
     let dir = tempfile::tempdir().unwrap();

@@ -72,6 +72,13 @@ fn at_least_one(s: &str) -> Result<usize, String> {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
+    // Every table is read beside the machine it ran on (issue 18: CPUs of one kind differ).
+    println!(
+        "machine: {}, {} threads available, SIMD level {}",
+        cpu_model(),
+        rayon::current_num_threads(),
+        lbdem_core::simd::level().name()
+    );
     match a.which {
         Which::Bandwidth => bandwidth::run(a),
         Which::Radiograph => radiograph::run(a),
@@ -82,6 +89,19 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Which::Su2020 => su2020::run(a),
         Which::Resolution => resolution::run(a),
     }
+}
+
+/// The CPU's model name as the kernel reports it ("unknown" off Linux).
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
 }
 
 /// Median of a sample (sorted copy); NaN-free input assumed.

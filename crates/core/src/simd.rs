@@ -69,7 +69,10 @@ pub struct UnknownLevel {
 /// before anything runs; [`arch`] ignores a value this refuses.
 pub fn requested() -> Result<Option<Level>, UnknownLevel> {
     match std::env::var(ISA_ENV) {
-        Err(_) => Ok(None),
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(raw)) => Err(UnknownLevel {
+            value: raw.to_string_lossy().into_owned(),
+        }),
         Ok(v) => match v.trim().to_ascii_lowercase().as_str() {
             "portable" | "scalar" | "baseline" => Ok(Some(Level::Portable)),
             "v3" | "avx2" => Ok(Some(Level::V3)),

@@ -177,13 +177,14 @@ impl<L: Lattice, T: Real> FluidModel<L, T> {
         let engine = make_engine(&su, &mut fluid, settings)?;
         if !crate::contract::quiet() {
             eprintln!(
-                "fluid: {} {} lattice {:?}, tau = {:.4}, dt = {:e} s, kernel {}",
+                "fluid: {} {} lattice {:?}, tau = {:.4}, dt = {:e} s, kernel {}, SIMD {}",
                 L::NAME,
                 T::NAME,
                 &su.n[..su.dim],
                 su.units.tau,
                 su.units.dt,
-                su.kernel
+                su.kernel,
+                lbdem_core::simd::level().name()
             );
         }
         Ok(Self {
