@@ -10,7 +10,8 @@
 //! - `domain.rs`: the box, periodic on any axis (minimum image);
 //! - `cells.rs`: linked-cell broad phase building a sorted Verlet list with a skin, reaching the
 //!   law's range;
-//! - `law/`: the contact-law seam and the laws ([`HertzMindlinSpring`]);
+//! - `law/`: the contact-law seam and the laws ([`HertzMindlinSpring`]; Ness et al. 2017's
+//!   [`LinearSpring`] and [`Lubrication`], combined by [`Lubricated`]);
 //! - `clump.rs`: rigid clumps (mass properties of the union of spheres, principal axes, the
 //!   body-frame free rotation);
 //! - `hook.rs`: user forces;
@@ -35,6 +36,9 @@ pub use clump::{BodyFrame, ClumpTemplate, Clumps};
 pub use domain::Domain3;
 pub use error::SphereError;
 pub use hook::SphereForceHook;
-pub use law::{Elastic, HertzMindlinSpring, Interaction, Response, SphereLaw, Surface, TimeStepLimit};
+pub use law::{
+    Elastic, HertzMindlinSpring, Interaction, LinearSpring, Lubricated, Lubrication, Response, SphereLaw,
+    Surface, TimeStepLimit,
+};
 pub use stepper::{SphereStepParams, SphereStepper, max_time_step};
 pub use system::{FREE, PlaneWall, SphereContacts, SphereSystem, Spheres};

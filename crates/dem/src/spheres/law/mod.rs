@@ -10,15 +10,22 @@
 //! at the contact point (j receives its negative); the couples `torque_i`, `torque_j` are added
 //! on top of the moments of the force about the centres.
 //!
-//! - `hertz_mindlin.rs`: [`HertzMindlinSpring`], LIGGGHTS `hertz tangential history`.
+//! - `hertz_mindlin.rs`: [`HertzMindlinSpring`], LIGGGHTS `hertz tangential history`;
+//! - `linear.rs`: [`LinearSpring`], Ness et al. (2017) Eq. 6 (Cundall & Strack spring, no damping);
+//! - `lubrication.rs`: [`Lubrication`], Ness et al. (2017) Eqs. 3-5, and [`Lubricated`], it
+//!   added to any contact law.
 
 pub mod hertz_mindlin;
+pub mod linear;
+pub mod lubrication;
 
 use super::error::SphereError;
 use crate::history::HistoryData;
 use crate::vector::{Vec3, Vector};
 
 pub use hertz_mindlin::{Elastic, HertzMindlinSpring, Surface};
+pub use linear::LinearSpring;
+pub use lubrication::{Lubricated, Lubrication};
 
 /// Geometry and kinematics of one sphere-sphere or sphere-wall interaction, seen from sphere i.
 #[derive(Clone, Copy, Debug)]
