@@ -310,6 +310,7 @@ fn linear_contact_collision_is_elastic_and_lasts_half_a_period() {
         dv: Vec3::new(0.0, v_t, 0.0),
         dw: Vec3::ZERO,
         wall,
+        frozen: false,
         dt: 1e-6,
     };
     let delta = 1e-6;

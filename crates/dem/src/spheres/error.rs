@@ -53,6 +53,19 @@ pub enum SphereError {
         found: String,
         expected: String,
     },
+    #[error(
+        "sphere index {sphere} is out of range: the system has {count} spheres; pass an index below {count}"
+    )]
+    NoSuchSphere { sphere: usize, count: usize },
+    #[error(
+        "sphere {sphere} belongs to clump {clump} and cannot be {action} by itself; act on free \
+         spheres only"
+    )]
+    ClumpMember {
+        sphere: usize,
+        clump: usize,
+        action: &'static str,
+    },
     #[error("clump {clump}: non-finite position, velocity or spin given; pass finite values")]
     NonFiniteClump { clump: usize },
     #[error(

@@ -51,8 +51,8 @@ pub struct SphereStepper<L: SphereLaw> {
     cells: CellList3,
     new_pairs: Vec<[u32; 2]>,
     new_hist: Histories,
-    /// The (dt, law, sphere count) last checked.
-    checked: Option<(f64, L, usize)>,
+    /// The (dt, law, sphere count, frozen count) last checked.
+    checked: Option<(f64, L, usize, usize)>,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
@@ -69,11 +69,13 @@ impl<L: SphereLaw> Default for SphereStepper<L> {
     }
 }
 
-/// The smallest time-step limit of `law` over the spheres of `sys`, and the sphere that sets it
-/// (`None` with no spheres).
+/// The smallest time-step limit of `law` over the mobile spheres of `sys` (frozen ones are not
+/// integrated; against a frozen grain m* is the mobile sphere's mass, above the m/2 of two equal
+/// spheres the laws bound), and the sphere that sets it (`None` with no mobile spheres).
 pub fn max_time_step<L: SphereLaw>(law: &L, sys: &SphereSystem) -> Option<(usize, TimeStepLimit)> {
     let s = &sys.spheres;
     (0..s.len())
+        .filter(|&k| !sys.is_frozen(k))
         .map(|k| (k, law.max_time_step(s.radius[k], s.mass[k])))
         .reduce(|a, b| if b.1.dt < a.1.dt { b } else { a })
 }
@@ -85,10 +87,11 @@ impl<L: SphereLaw> SphereStepper<L> {
 
     fn check(&mut self, p: &SphereStepParams, law: &L, sys: &SphereSystem) -> Result<(), SphereError> {
         let n = sys.spheres.len();
+        let nf = sys.spheres.frozen.iter().filter(|&&f| f).count();
         if self
             .checked
             .as_ref()
-            .is_some_and(|(dt, l, m)| *dt == p.dt && l == law && *m == n)
+            .is_some_and(|(dt, l, m, f)| *dt == p.dt && l == law && *m == n && *f == nf)
         {
             return Ok(());
         }
@@ -121,7 +124,7 @@ impl<L: SphereLaw> SphereStepper<L> {
                 bound: limit.bound,
             });
         }
-        self.checked = Some((p.dt, law.clone(), n));
+        self.checked = Some((p.dt, law.clone(), n, nf));
         Ok(())
     }
 
@@ -148,9 +151,10 @@ impl<L: SphereLaw> SphereStepper<L> {
         let h = 0.5 * dt;
         let dom = sys.domain;
         let n = sys.spheres.len();
-        // Opening half kick and drift: free spheres, then clumps (members placed on them).
+        // Opening half kick and drift: mobile spheres (frozen ones stay), then clumps (members
+        // placed on them).
         for k in 0..n {
-            if sys.is_free(k) {
+            if sys.is_mobile(k) {
                 let s = &mut sys.spheres;
                 s.vel[k] += s.force[k] * (h / s.mass[k]);
                 s.omega[k] += s.torque[k] * (h / s.inertia[k]);
@@ -174,7 +178,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         self.forces(p, law, sys, hook);
         // Closing half kick.
         for k in 0..n {
-            if sys.is_free(k) {
+            if sys.is_mobile(k) {
                 let s = &mut sys.spheres;
                 s.vel[k] += s.force[k] * (h / s.mass[k]);
                 s.omega[k] += s.torque[k] * (h / s.inertia[k]);
@@ -223,6 +227,10 @@ impl<L: SphereLaw> SphereStepper<L> {
                 |a, b| law.range(a, b),
                 &mut self.new_pairs,
             )?;
+            // Two frozen grains never move relative to each other: no pair.
+            let frozen = &s.frozen;
+            self.new_pairs
+                .retain(|p| !(frozen[p[0] as usize] && frozen[p[1] as usize]));
             let new = self.new_hist.conform::<L::History>(self.new_pairs.len());
             new.fill(L::History::default());
             let old = c.hist.as_slice::<L::History>().unwrap_or(&[]);
@@ -271,18 +279,28 @@ impl<L: SphereLaw> SphereStepper<L> {
             // = distance, so the pair conserves angular momentum.
             let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
             let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (s.vel[j] + s.omega[j].cross(nrm * -aj));
-            let (mi, mj) = (body_mass(s, cl, i), body_mass(s, cl, j));
+            let (fi, fj) = (s.frozen[i], s.frozen[j]);
+            // m* of a mobile-frozen pair is the mobile body's mass: the frozen one is immovable.
+            let m_eff = match (fi, fj) {
+                (false, true) => body_mass(s, cl, i),
+                (true, false) => body_mass(s, cl, j),
+                _ => {
+                    let (mi, mj) = (body_mass(s, cl, i), body_mass(s, cl, j));
+                    mi * mj / (mi + mj)
+                }
+            };
             let it = Interaction {
                 n: nrm,
                 delta,
                 r_i: ri,
                 r_j: rj,
                 r_eff: ri * rj / (ri + rj),
-                m_eff: mi * mj / (mi + mj),
+                m_eff,
                 v_rel,
                 dv: s.vel[i] - s.vel[j],
                 dw: s.omega[i] - s.omega[j],
                 wall: false,
+                frozen: fi || fj,
                 dt: p.dt,
             };
             let out = law.force(&it, h);
@@ -318,6 +336,7 @@ impl<L: SphereLaw> SphereStepper<L> {
                         dv: s.vel[k] - wall.vel,
                         dw: s.omega[k],
                         wall: true,
+                        frozen: false,
                         dt: p.dt,
                     };
                     let out = law.force(&it, h);
@@ -328,7 +347,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         }
         if p.gravity != Vec3::ZERO {
             for k in 0..n {
-                if s.owner[k] == FREE {
+                if s.owner[k] == FREE && !s.frozen[k] {
                     s.force[k] += p.gravity * s.mass[k];
                 }
             }

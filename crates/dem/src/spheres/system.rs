@@ -32,6 +32,11 @@ pub struct Spheres {
     /// The clump a sphere belongs to, or [`FREE`] (absent in older checkpoints: all free).
     #[serde(default)]
     pub owner: Vec<u32>,
+    /// Frozen grains (Ness et al. 2017's walls of fixed small spheres): not integrated (position
+    /// fixed, velocity and spin zero), pairs of two frozen grains left out of the list, the force
+    /// on them still summed in `force` (the wall's load). Absent in older checkpoints: all mobile.
+    #[serde(default)]
+    pub frozen: Vec<bool>,
 }
 
 /// `owner` of a sphere that belongs to no clump.
@@ -163,6 +168,7 @@ impl SphereSystem {
         s.mass.push(m);
         s.inertia.push(0.4 * m * r * r);
         s.owner.push(FREE);
+        s.frozen.push(false);
         Ok(s.len() - 1)
     }
 
@@ -215,6 +221,41 @@ impl SphereSystem {
     #[inline]
     pub fn is_free(&self, k: usize) -> bool {
         self.spheres.owner.get(k).is_none_or(|&o| o == FREE)
+    }
+
+    /// True if sphere `k` is frozen (see [`Spheres::frozen`]).
+    #[inline]
+    pub fn is_frozen(&self, k: usize) -> bool {
+        self.spheres.frozen.get(k).is_some_and(|&f| f)
+    }
+
+    /// True if sphere `k` is integrated by itself: free and not frozen.
+    #[inline]
+    pub fn is_mobile(&self, k: usize) -> bool {
+        self.is_free(k) && !self.is_frozen(k)
+    }
+
+    /// Freeze sphere `k` in place (its velocity and spin set to zero) or release it. A clump
+    /// member cannot be frozen (the clump integrates it).
+    pub fn set_frozen(&mut self, k: usize, frozen: bool) -> Result<(), SphereError> {
+        let n = self.spheres.len();
+        if k >= n {
+            return Err(SphereError::NoSuchSphere { sphere: k, count: n });
+        }
+        if !self.is_free(k) {
+            return Err(SphereError::ClumpMember {
+                sphere: k,
+                clump: self.spheres.owner[k] as usize,
+                action: "frozen",
+            });
+        }
+        let s = &mut self.spheres;
+        s.frozen[k] = frozen;
+        if frozen {
+            s.vel[k] = Vec3::ZERO;
+            s.omega[k] = Vec3::ZERO;
+        }
+        Ok(())
     }
 
     /// Translational plus rotational kinetic energy of free spheres and clumps (J).

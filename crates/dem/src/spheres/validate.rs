@@ -44,6 +44,10 @@ impl TryFrom<RawSphereSystem> for SphereSystem {
         if sys.spheres.owner.is_empty() {
             sys.spheres.owner = vec![FREE; sys.spheres.len()];
         }
+        // Checkpoints from before frozen grains: every sphere mobile.
+        if sys.spheres.frozen.is_empty() {
+            sys.spheres.frozen = vec![false; sys.spheres.len()];
+        }
         sys.validate()?;
         Ok(sys)
     }
@@ -97,6 +101,7 @@ impl SphereSystem {
         len_is("spheres.mass", s.mass.len(), n)?;
         len_is("spheres.inertia", s.inertia.len(), n)?;
         len_is("spheres.owner", s.owner.len(), n)?;
+        len_is("spheres.frozen", s.frozen.len(), n)?;
         for (field, v) in [
             ("spheres.pos", &s.pos),
             ("spheres.vel", &s.vel),
@@ -105,6 +110,18 @@ impl SphereSystem {
             ("spheres.torque", &s.torque),
         ] {
             all_finite(field, v)?;
+        }
+        if let Some(k) = (0..n).find(|&k| {
+            s.frozen[k] && (s.owner[k] != FREE || s.vel[k] != Vec3::ZERO || s.omega[k] != Vec3::ZERO)
+        }) {
+            return Err(bad(
+                "spheres.frozen",
+                format!(
+                    "sphere {k} frozen with owner {}, velocity {:?}, spin {:?}",
+                    s.owner[k], s.vel[k], s.omega[k]
+                ),
+                "frozen spheres free of clumps, at rest",
+            ));
         }
         all_positive("spheres.radius", s.radius.iter().copied())?;
         all_positive("spheres.mass", s.mass.iter().copied())?;

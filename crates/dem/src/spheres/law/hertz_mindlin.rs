@@ -298,6 +298,7 @@ mod tests {
             dv: v_rel,
             dw: Vec3::ZERO,
             wall: false,
+            frozen: false,
             dt: 1e-4,
         }
     }

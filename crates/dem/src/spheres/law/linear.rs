@@ -92,7 +92,7 @@ impl SphereLaw for LinearSpring {
         }
         let f_n = self.k_n * c.delta;
         let vt = c.v_rel - c.n * c.v_rel.dot(c.n);
-        let mu = if c.wall { self.wall_mu } else { self.mu };
+        let mu = if c.wall || c.frozen { self.wall_mu } else { self.mu };
         let f_t = tangential_spring(u, c.n, vt, c.dt, self.k_t, 0.0, mu * f_n);
         Response {
             f: f_t - c.n * f_n,

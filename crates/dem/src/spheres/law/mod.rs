@@ -50,6 +50,11 @@ pub struct Interaction {
     pub dw: Vec3,
     /// True for a sphere-wall contact.
     pub wall: bool,
+    /// True if one sphere of the pair is frozen (a wall of grains, Ness et al. 2017): the
+    /// friction of [`LinearSpring`] is then μ_w, as against a plane wall, its geometry that of
+    /// two spheres. With `wall`, the pair table of friction: μ_p between mobile spheres, μ_w
+    /// against walls of either kind.
+    pub frozen: bool,
     /// Time step (s).
     pub dt: f64,
 }
