@@ -161,6 +161,10 @@ impl Stage for MinimalModels {
         let mut figures = Vec::new();
         let mut files = vec![PathBuf::from("minimal.csv")];
         for s in &p.studies {
+            // A chart needs a point: a shift with a bound and a measured time saved.
+            if !rows.iter().any(|r| std::ptr::eq(r.study, s) && drawable(r)) {
+                continue;
+            }
             let file = format!("minimal_{}.png", slug(&s.study));
             chart(&ctx.out_dir.join(&file), s, &rows)?;
             figures.push(Figure {
@@ -208,6 +212,11 @@ impl Stage for MinimalModels {
             files,
         })
     }
+}
+
+/// A row the chart can place: a finite bound and a measured time saved.
+fn drawable(r: &Row) -> bool {
+    r.shift.bound().is_finite() && r.time_saved().is_finite()
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -281,7 +290,7 @@ fn write(path: &std::path::Path, rows: &[Row]) -> Result<()> {
 fn chart(path: &std::path::Path, s: &Study, rows: &[Row]) -> Result<()> {
     let mine: Vec<&Row> = rows
         .iter()
-        .filter(|r| std::ptr::eq(r.study, s) && r.shift.bound().is_finite() && r.time_saved().is_finite())
+        .filter(|r| std::ptr::eq(r.study, s) && drawable(r))
         .collect();
     let data: Vec<(String, Vec<f64>, Vec<f64>)> = mine
         .iter()
