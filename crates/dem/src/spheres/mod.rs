@@ -8,6 +8,7 @@
 //! add forces through a [`SphereForceHook`]. No file I/O.
 //!
 //! - `domain.rs`: the box, periodic on any axis (minimum image);
+//! - `edit.rs`: removing spheres (the open outlet), histories remapped;
 //! - `cells.rs`: linked-cell broad phase building a sorted Verlet list with a skin, reaching the
 //!   law's range;
 //! - `law/`: the contact-law seam and the laws ([`HertzMindlinSpring`]; Ness et al. 2017's
@@ -25,6 +26,7 @@
 pub mod cells;
 pub mod clump;
 pub mod domain;
+pub mod edit;
 pub mod error;
 pub mod hook;
 pub mod law;

@@ -311,6 +311,15 @@ impl<L: SphereLaw> SphereStepper<L> {
             s.torque[j] += tq * aj + out.torque_j;
         }
         let nw = sys.walls.len();
+        // Spheres appended since the last evaluation get fresh records, the others keep theirs
+        // (sphere-major layout); a changed wall count resets them all.
+        let laid_out = c.wall_count == nw || (c.wall_count == 0 && c.wall_hist.len() == n * nw);
+        if laid_out {
+            c.wall_hist.resize::<L::History>(n * nw);
+        } else {
+            c.wall_hist.reset::<L::History>(n * nw);
+        }
+        c.wall_count = nw;
         let wall_hist = c.wall_hist.conform::<L::History>(n * nw);
         if nw > 0 {
             for k in 0..n {

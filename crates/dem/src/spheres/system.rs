@@ -91,8 +91,14 @@ pub struct SphereContacts {
     pub pairs: Vec<[u32; 2]>,
     /// History of each pair (fresh when out of the law's range).
     pub hist: Histories,
-    /// History of each sphere-wall contact, index `sphere * n_walls + wall`.
+    /// History of each sphere-wall contact, index `sphere * n_walls + wall` (sphere-major:
+    /// appended spheres append records, a removed sphere takes its row out).
     pub wall_hist: Histories,
+    /// The wall count `wall_hist` is laid out for (0 in older checkpoints: then the records
+    /// are kept only if there are exactly spheres × walls of them). Adding or removing a wall
+    /// resets the sphere-wall histories.
+    #[serde(default)]
+    pub wall_count: usize,
     /// Sphere positions when the list was built (the rebuild test reads them).
     pub list_ref: Vec<Vec3>,
 }
