@@ -17,7 +17,8 @@
 //!   body-frame free rotation);
 //! - `hook.rs`: user forces;
 //! - `validate.rs`: the consistency check of a state (checkpoints are user input);
-//! - `stepper.rs`: velocity Verlet, serial.
+//! - `stepper.rs`: velocity Verlet, serial;
+//! - `stress.rs`: the per-contact forces of the last evaluation and the dipole stress sum.
 //!
 //! Validated against Chung & Ooi (2011) benchmarks 1-4 (`crates/dem/tests/chung_ooi.rs`,
 //! `docs/dem3d.md`); clumps in `crates/dem/tests/clumps.rs`. Not yet here: parallel passes,
@@ -31,6 +32,7 @@ pub mod error;
 pub mod hook;
 pub mod law;
 pub mod stepper;
+pub mod stress;
 pub mod system;
 pub mod validate;
 
@@ -43,4 +45,5 @@ pub use law::{
     Surface, TimeStepLimit,
 };
 pub use stepper::{SphereStepParams, SphereStepper, max_time_step};
+pub use stress::{ContactForce, Partner, dipole_stress};
 pub use system::{FREE, PlaneWall, SphereContacts, SphereSystem, Spheres};

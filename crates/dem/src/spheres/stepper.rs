@@ -15,7 +15,8 @@ use super::cells::CellList3;
 use super::clump::{Clumps, free_rotation, quat_array};
 use super::error::SphereError;
 use super::hook::{NoHook, SphereForceHook, user_forces};
-use super::law::{Interaction, SphereLaw, TimeStepLimit};
+use super::law::{Interaction, Response, SphereLaw, TimeStepLimit};
+use super::stress::{ContactForce, Partner};
 use super::system::{FREE, SphereSystem, Spheres};
 use crate::history::Histories;
 use crate::neighbor::carry_history_into;
@@ -53,6 +54,8 @@ pub struct SphereStepper<L: SphereLaw> {
     new_hist: Histories,
     /// The (dt, law, sphere count, frozen count) last checked.
     checked: Option<(f64, L, usize, usize)>,
+    /// Interactions of the last force evaluation ([`Self::contacts`]).
+    records: Vec<ContactForce>,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
@@ -64,6 +67,7 @@ impl<L: SphereLaw> Default for SphereStepper<L> {
             new_pairs: Vec::new(),
             new_hist: Histories::default(),
             checked: None,
+            records: Vec::new(),
             rebuilds: 0,
         }
     }
@@ -83,6 +87,14 @@ pub fn max_time_step<L: SphereLaw>(law: &L, sys: &SphereSystem) -> Option<(usize
 impl<L: SphereLaw> SphereStepper<L> {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Every interaction that exerted a force in the last force evaluation (pairs in list
+    /// order, then sphere-wall contacts; the end of the last step, or the priming at step 0),
+    /// with its contact point, branch vector and force, for stress sums
+    /// ([`super::dipole_stress`]). Empty before this stepper's first step.
+    pub fn contacts(&self) -> &[ContactForce] {
+        &self.records
     }
 
     fn check(&mut self, p: &SphereStepParams, law: &L, sys: &SphereSystem) -> Result<(), SphereError> {
@@ -261,6 +273,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         let n = s.len();
         s.force.fill(Vec3::ZERO);
         s.torque.fill(Vec3::ZERO);
+        self.records.clear();
         let hist = c.hist.conform::<L::History>(c.pairs.len());
         for (pair, h) in c.pairs.iter().zip(hist.iter_mut()) {
             let (i, j) = (pair[0] as usize, pair[1] as usize);
@@ -304,6 +317,16 @@ impl<L: SphereLaw> SphereStepper<L> {
                 dt: p.dt,
             };
             let out = law.force(&it, h);
+            if out != Response::default() {
+                self.records.push(ContactForce {
+                    i: pair[0],
+                    j: Partner::Sphere(pair[1]),
+                    point: s.pos[i] + nrm * ai,
+                    branch: d,
+                    force: out.f,
+                    hydro: out.f_hydro,
+                });
+            }
             s.force[i] += out.f;
             s.force[j] -= out.f;
             let tq = nrm.cross(out.f);
@@ -349,6 +372,16 @@ impl<L: SphereLaw> SphereStepper<L> {
                         dt: p.dt,
                     };
                     let out = law.force(&it, h);
+                    if out != Response::default() {
+                        self.records.push(ContactForce {
+                            i: k as u32,
+                            j: Partner::Wall(w as u32),
+                            point: s.pos[k] + nrm * a,
+                            branch: nrm * a,
+                            force: out.f,
+                            hydro: out.f_hydro,
+                        });
+                    }
                     s.force[k] += out.f;
                     s.torque[k] += nrm.cross(out.f) * a + out.torque_i;
                 }

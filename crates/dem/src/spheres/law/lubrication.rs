@@ -114,6 +114,7 @@ impl Lubrication {
             f,
             torque_i: -dw_t * (pu_i * PI * eta * di * di * di),
             torque_j: dw_t * (pu_j * PI * eta * dj * dj * dj),
+            f_hydro: f,
         }
     }
 
@@ -197,6 +198,7 @@ impl<C: SphereLaw> SphereLaw for Lubricated<C> {
             f: a.f + b.f,
             torque_i: a.torque_i + b.torque_i,
             torque_j: a.torque_j + b.torque_j,
+            f_hydro: a.f_hydro + b.f_hydro,
         }
     }
 

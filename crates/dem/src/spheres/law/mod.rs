@@ -68,6 +68,9 @@ pub struct Response {
     pub torque_i: Vec3,
     /// Couple on j besides the moment of −`f` (N m; ignored for a wall).
     pub torque_j: Vec3,
+    /// The hydrodynamic part of `f` (N): lubrication, for the split of the stress into
+    /// Ness et al.'s Σ^H and Σ^C (Eq. 7a, 7b); zero for a contact law.
+    pub f_hydro: Vec3,
 }
 
 /// A contact law of spheres.
