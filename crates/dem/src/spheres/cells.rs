@@ -106,36 +106,53 @@ impl CellList3 {
             self.sorted[self.fill[c as usize] as usize] = i as u32;
             self.fill[c as usize] += 1;
         }
-        // Neighbour indices along one axis: deduplicated, wrapped on a periodic axis.
-        let axis_nb = |c: usize, k: usize| -> ([usize; 3], usize) {
+        // Neighbour indices along one axis: deduplicated, wrapped on a periodic axis; with
+        // whether a neighbour was reached across a face.
+        let axis_nb = |c: usize, k: usize| -> ([usize; 3], [bool; 3], usize) {
             let mut out = [0usize; 3];
+            let mut across = [false; 3];
             let mut m = 0;
             for d in -1isize..=1 {
                 let mut j = c as isize + d;
+                let crossed = j < 0 || j >= nc[k] as isize;
                 if dom.periodic[k] {
                     j = j.rem_euclid(nc[k] as isize);
-                } else if j < 0 || j >= nc[k] as isize {
+                } else if crossed {
                     continue;
                 }
                 let j = j as usize;
-                if !out[..m].contains(&j) {
-                    out[m] = j;
-                    m += 1;
+                match out[..m].iter().position(|&o| o == j) {
+                    Some(q) => across[q] |= crossed,
+                    None => {
+                        out[m] = j;
+                        across[m] = crossed;
+                        m += 1;
+                    }
                 }
             }
-            (out, m)
+            (out, across, m)
         };
+        // Lees-Edwards: the cells across a y face are displaced along x by the strain offset,
+        // so a sphere whose y-neighbour layer lies across the face searches that layer's whole
+        // x row (2 of every n_y layers do; the minimum image decides).
+        let sheared = dom.shear.is_some();
+        let all_x: Vec<usize> = (0..nc[0]).collect();
         for i in 0..n {
             let c = self.cell[i] as usize;
             let (cx, cy, cz) = (c % nc[0], (c / nc[0]) % nc[1], c / (nc[0] * nc[1]));
-            let (xs, mx) = axis_nb(cx, 0);
-            let (ys, my) = axis_nb(cy, 1);
-            let (zs, mz) = axis_nb(cz, 2);
+            let (xs, _, mx) = axis_nb(cx, 0);
+            let (ys, y_across, my) = axis_nb(cy, 1);
+            let (zs, _, mz) = axis_nb(cz, 2);
             self.nb.clear();
             let (pi, ri) = (pos[i], r[i]);
             for &z in &zs[..mz] {
-                for &y in &ys[..my] {
-                    for &x in &xs[..mx] {
+                for (&y, &y_across) in ys[..my].iter().zip(&y_across[..my]) {
+                    let row = if sheared && y_across {
+                        &all_x[..]
+                    } else {
+                        &xs[..mx]
+                    };
+                    for &x in row {
                         let cc = (z * nc[1] + y) * nc[0] + x;
                         let members = self.cell_start[cc] as usize..self.cell_start[cc + 1] as usize;
                         for &j in &self.sorted[members] {
@@ -245,6 +262,31 @@ mod tests {
                 .collect();
             assert!(want_r.len() > want.len());
             assert_eq!(got, want_r, "periodic {periodic:?}, with a range");
+        }
+        // Lees-Edwards boxes (x and y periodic, z either), at several offsets and with 5 and
+        // 2 cell layers along y: the sheared minimum image, and no pair missed across the
+        // displaced faces.
+        for (ly, periodic_z) in [(0.6, false), (0.6, true), (0.25, true)] {
+            let hi = Vec3::new(1.0, ly, 0.45);
+            let pos_y: Vec<Vec3> = pos.iter().map(|p| Vec3::new(p.x, p.y * ly / 0.6, p.z)).collect();
+            for offset in [0.0, 0.013, 0.37, 0.5, 0.93] {
+                let mut dom = Domain3::new(Vec3::ZERO, hi, [true, true, periodic_z])
+                    .unwrap()
+                    .with_lees_edwards(0.7)
+                    .unwrap();
+                dom.shear.as_mut().unwrap().offset = offset;
+                let mut got = Vec::new();
+                cl.build_pairs(&dom, &pos_y, &r, &[], 0.01, no_range, &mut got)
+                    .unwrap();
+                let want = brute_force_pairs(&dom, &pos_y, &r, &[], 0.01);
+                // Pairs across the sheared faces are there (some with the x shift).
+                let across = want
+                    .iter()
+                    .filter(|&&[i, j]| (pos_y[j as usize].y - pos_y[i as usize].y).abs() > 0.5 * ly)
+                    .count();
+                assert!(across > 0, "offset {offset}");
+                assert_eq!(got, want, "Lees-Edwards, L_y {ly}, offset {offset}");
+            }
         }
         // An axis too short for a unique minimum image is refused.
         let dom = Domain3::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.2), [false, false, true]).unwrap();

@@ -7,7 +7,7 @@
 //! contact law ([`SphereLaw`]: its range beyond contact, its history, its stable step), callers
 //! add forces through a [`SphereForceHook`]. No file I/O.
 //!
-//! - `domain.rs`: the box, periodic on any axis (minimum image);
+//! - `domain.rs`: the box, periodic on any axis (minimum image), Lees-Edwards shear;
 //! - `edit.rs`: removing spheres (the open outlet), histories remapped;
 //! - `cells.rs`: linked-cell broad phase building a sorted Verlet list with a skin, reaching the
 //!   law's range;
@@ -37,7 +37,7 @@ pub mod system;
 pub mod validate;
 
 pub use clump::{BodyFrame, ClumpTemplate, Clumps};
-pub use domain::Domain3;
+pub use domain::{Domain3, LeesEdwards};
 pub use error::SphereError;
 pub use hook::SphereForceHook;
 pub use law::{

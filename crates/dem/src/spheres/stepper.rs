@@ -161,6 +161,8 @@ impl<L: SphereLaw> SphereStepper<L> {
         }
         let dt = p.dt;
         let h = 0.5 * dt;
+        // The Lees-Edwards images move first: positions at t + dt wrap with the offset of t + dt.
+        sys.domain.advance(dt);
         let dom = sys.domain;
         let n = sys.spheres.len();
         // Opening half kick and drift: mobile spheres (frozen ones stay), then clumps (members
@@ -170,14 +172,14 @@ impl<L: SphereLaw> SphereStepper<L> {
                 let s = &mut sys.spheres;
                 s.vel[k] += s.force[k] * (h / s.mass[k]);
                 s.omega[k] += s.torque[k] * (h / s.inertia[k]);
-                s.pos[k] = dom.wrap(s.pos[k] + s.vel[k] * dt);
+                (s.pos[k], s.vel[k]) = dom.wrap_moving(s.pos[k] + s.vel[k] * dt, s.vel[k]);
             }
         }
         let c = &mut sys.clumps;
         for k in 0..c.len() {
             c.vel[k] += c.force[k] * (h / c.mass[k]);
             c.ang_mom[k] += c.torque[k] * h;
-            c.pos[k] = dom.wrap(c.pos[k] + c.vel[k] * dt);
+            (c.pos[k], c.vel[k]) = dom.wrap_moving(c.pos[k] + c.vel[k] * dt, c.vel[k]);
             let q = free_rotation(c.orientation(k), c.ang_mom[k], c.inertia[k], dt);
             c.quat[k] = quat_array(&q);
         }
@@ -222,8 +224,19 @@ impl<L: SphereLaw> SphereStepper<L> {
         let s = &sys.spheres;
         let c = &mut sys.contacts;
         let n = s.len();
-        let fresh = c.list_ref.len() == n && c.hist.len() == c.pairs.len() && {
-            let lim = 0.25 * skin * skin;
+        // Each sphere may move skin/2 (two of them: skin); on a Lees-Edwards box a pair across
+        // the sheared faces also slides by the change of the offset, taken off the skin first.
+        let slide = match dom.shear {
+            Some(le) => {
+                let lx = dom.size().x;
+                let ds = le.offset - c.list_offset;
+                (ds - lx * (ds / lx).round()).abs()
+            }
+            None => 0.0,
+        };
+        let fresh = c.list_ref.len() == n && c.hist.len() == c.pairs.len() && slide <= skin && {
+            let half = 0.5 * (skin - slide);
+            let lim = half * half;
             s.pos
                 .iter()
                 .zip(&c.list_ref)
@@ -252,6 +265,7 @@ impl<L: SphereLaw> SphereStepper<L> {
             std::mem::swap(&mut c.hist, &mut self.new_hist);
             c.list_ref.clear();
             c.list_ref.extend_from_slice(&s.pos);
+            c.list_offset = dom.shear_offset();
             self.rebuilds += 1;
         }
         Ok(())
@@ -277,7 +291,8 @@ impl<L: SphereLaw> SphereStepper<L> {
         let hist = c.hist.conform::<L::History>(c.pairs.len());
         for (pair, h) in c.pairs.iter().zip(hist.iter_mut()) {
             let (i, j) = (pair[0] as usize, pair[1] as usize);
-            let d = dom.min_image(s.pos[j] - s.pos[i]);
+            // On a Lees-Edwards box the image of j across a y face moves at v_j + dv_j.
+            let (d, dv_j) = dom.min_image_moving(s.pos[j] - s.pos[i]);
             let (ri, rj) = (s.radius[i], s.radius[j]);
             let dist2 = d.norm2();
             let reach = ri + rj + law.range(ri, rj);
@@ -291,7 +306,8 @@ impl<L: SphereLaw> SphereStepper<L> {
             // Arms to the contact point, halfway into the overlap (or across the gap): a_i + a_j
             // = distance, so the pair conserves angular momentum.
             let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
-            let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (s.vel[j] + s.omega[j].cross(nrm * -aj));
+            let v_j = s.vel[j] + dv_j;
+            let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (v_j + s.omega[j].cross(nrm * -aj));
             let (fi, fj) = (s.frozen[i], s.frozen[j]);
             // m* of a mobile-frozen pair is the mobile body's mass: the frozen one is immovable.
             let m_eff = match (fi, fj) {
@@ -310,7 +326,7 @@ impl<L: SphereLaw> SphereStepper<L> {
                 r_eff: ri * rj / (ri + rj),
                 m_eff,
                 v_rel,
-                dv: s.vel[i] - s.vel[j],
+                dv: s.vel[i] - v_j,
                 dw: s.omega[i] - s.omega[j],
                 wall: false,
                 frozen: fi || fj,
@@ -418,10 +434,12 @@ fn place_members(sys: &mut SphereSystem, positions: bool) {
         let w = c.omega(k);
         for (m, b) in c.members_of(k) {
             let arm = b.rotated_by(&q);
+            // A member placed across a Lees-Edwards face takes that image's velocity.
+            let (p, v) = dom.wrap_moving(c.pos[k] + arm, c.vel[k] + w.cross(arm));
             if positions {
-                s.pos[m] = dom.wrap(c.pos[k] + arm);
+                s.pos[m] = p;
             }
-            s.vel[m] = c.vel[k] + w.cross(arm);
+            s.vel[m] = v;
             s.omega[m] = w;
         }
     }

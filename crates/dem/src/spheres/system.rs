@@ -101,6 +101,10 @@ pub struct SphereContacts {
     pub wall_count: usize,
     /// Sphere positions when the list was built (the rebuild test reads them).
     pub list_ref: Vec<Vec3>,
+    /// The Lees-Edwards offset when the list was built (0 in older checkpoints and without
+    /// shear): pairs across the sheared faces move apart by its change as well.
+    #[serde(default)]
+    pub list_offset: f64,
 }
 
 /// A sphere assembly: state only (see the module docs).
@@ -134,7 +138,8 @@ impl SphereSystem {
     }
 
     /// Add a solid sphere of radius `r` and density `rho` at `pos` (wrapped into the box on
-    /// periodic axes) moving at `vel`, spinning at `omega`; returns its index.
+    /// periodic axes, its velocity shifted with it across Lees-Edwards faces) moving at `vel`,
+    /// spinning at `omega`; returns its index.
     pub fn add_sphere(
         &mut self,
         pos: Vec3,
@@ -165,7 +170,8 @@ impl SphereSystem {
             });
         }
         let m = rho * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
-        s.pos.push(self.domain.wrap(pos));
+        let (pos, vel) = self.domain.wrap_moving(pos, vel);
+        s.pos.push(pos);
         s.vel.push(vel);
         s.omega.push(omega);
         s.force.push(Vec3::ZERO);
@@ -212,7 +218,8 @@ impl SphereSystem {
         // L = Q I Qᵀ ω.
         let wb = omega.rotated_back_by(&q);
         let l = Vec3::new(i.x * wb.x, i.y * wb.y, i.z * wb.z).rotated_by(&q);
-        cl.pos.push(self.domain.wrap(pos));
+        let (pos, vel) = self.domain.wrap_moving(pos, vel);
+        cl.pos.push(pos);
         cl.vel.push(vel);
         cl.quat.push(quat_array(&q));
         cl.ang_mom.push(l);

@@ -91,6 +91,10 @@ impl SphereSystem {
     /// Check the state's consistency (see the module docs).
     pub fn validate(&self) -> Result<(), SphereError> {
         Domain3::new(self.domain.lo, self.domain.hi, self.domain.periodic)?;
+        self.domain.check_shear()?;
+        if !self.contacts.list_offset.is_finite() {
+            return Err(bad("contacts.list_offset", self.contacts.list_offset, "finite"));
+        }
         let s = &self.spheres;
         let n = s.len();
         len_is("spheres.vel", s.vel.len(), n)?;
