@@ -3,6 +3,8 @@
 //! in Su et al. 2020 Table 3), partially saturated cells, on 1 and 2 threads, with the share of
 //! time in LBM, DEM and coupling. The reference measured in the same run is the same grains
 //! stepped by the DEM alone (100 DEM steps per coupled step): the ratio is what the liquid costs.
+//! Two sizes, the cell and a quarter of it (half the side each way), so the cost growth with
+//! size is on record beside the growth with threads (issue 18 item 6).
 
 use super::{BenchArgs, median};
 use anyhow::Result;
@@ -94,22 +96,37 @@ fn build(sys: System) -> Result<Coupled<f64>> {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
-    let (cols, rows) = if a.quick { (27, 16) } else { (108, 65) };
+    let sizes: [(usize, usize); 2] = if a.quick {
+        [(27, 16), (14, 8)]
+    } else {
+        [(108, 65), (54, 33)]
+    };
     let steps = if a.quick { 3 } else { 10 };
-    let sys = shear_cell(cols, rows)?;
     let mut out = Vec::new();
-    {
+    for (cols, rows) in sizes {
+        out.extend(one_size(a, cols, rows, steps)?);
+    }
+    if let Some(path) = &a.json {
+        lbdem_core::atomic::write_atomic(path, &serde_json::to_vec_pretty(&out)?)?;
+    }
+    Ok(())
+}
+
+/// One grid of grains on 1 and 2 threads: a JSON row per thread count.
+fn one_size(a: &BenchArgs, cols: usize, rows: usize, steps: usize) -> Result<Vec<serde_json::Value>> {
+    let sys = shear_cell(cols, rows)?;
+    let grains = sys.bodies.len();
+    let mut out = Vec::new();
+    let [nx, ny] = {
         let c = build(sys.clone())?;
         let [nx, ny] = c.fluid.size();
         println!(
-            "coupled shear cell: {} two-circle grains, lattice {nx} x {ny}, tau {:.3}, ratio {}, PSM f64; \
+            "coupled shear cell: {grains} two-circle grains, lattice {nx} x {ny}, tau {:.3}, ratio {}, PSM f64; \
              median of {} runs of {steps} coupled steps",
-            c.sys.bodies.len(),
-            c.units.lattice.tau,
-            c.units.ratio,
-            a.reps
+            c.units.lattice.tau, c.units.ratio, a.reps
         );
-    }
+        [nx, ny]
+    };
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let (mut rates, mut dem_only, mut shares) = (Vec::new(), Vec::new(), Vec::new());
@@ -153,20 +170,19 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             .collect();
         println!(
             "  {threads} thread(s): {r:.2} coupled steps/s ({:.0} DEM sub-steps/s); time: LBM {:.0} %, DEM {:.0} %, \
-             coupling {:.0} %; DEM alone {d:.2} steps-of-100/s, ratio coupled/DEM-alone {:.2}",
+             coupling {:.0} %; DEM alone {d:.2} steps-of-100/s, ratio coupled/DEM-alone {:.2}; \
+             {:.2} M grain-substeps/s",
             r * RATIO as f64,
             100.0 * sh[0],
             100.0 * sh[1],
             100.0 * sh[2],
-            r / d
+            r / d,
+            r * RATIO as f64 * grains as f64 * 1e-6
         );
         out.push(serde_json::json!({
-            "threads": threads, "coupled_steps_per_s": r, "dem_alone_steps_per_s": d,
+            "grains": grains, "nodes": [nx, ny], "threads": threads, "coupled_steps_per_s": r, "dem_alone_steps_per_s": d,
             "share": { "lbm": sh[0], "dem": sh[1], "coupling": sh[2] }, "ratio_to_dem_alone": r / d,
         }));
     }
-    if let Some(path) = &a.json {
-        lbdem_core::atomic::write_atomic(path, &serde_json::to_vec_pretty(&out)?)?;
-    }
-    Ok(())
+    Ok(out)
 }

@@ -1,4 +1,4 @@
-//! `lbdem bench grains`: the digitise kernels on a synthetic image of ~1000 touching disks
+//! `lbdem bench grains`: the digitise kernels on synthetic images of ~1000 and ~300 touching disks
 //! and two-circle grains (`lbdem_grains::synth`). Prints, median of `--reps` runs on 1 and
 //! 2 threads: grains per second for the whole chain (threshold, distance transform,
 //! watershed, measures, two-circle fits, templates) and for the fits alone, and the chain's
@@ -27,7 +27,25 @@ struct Row {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
-    let (side, n) = if a.quick { (560, 300) } else { (1100, 1000) };
+    // Two sizes, so the cost growth with size is on record beside the growth with threads
+    // (issue 18 item 6).
+    let sizes: [(usize, usize); 2] = if a.quick {
+        [(560, 300), (400, 150)]
+    } else {
+        [(1100, 1000), (560, 300)]
+    };
+    let mut rows = Vec::new();
+    for (side, n) in sizes {
+        rows.extend(one_size(a, side, n)?);
+    }
+    if let Some(p) = &a.json {
+        lbdem_core::atomic::write_atomic(p, &serde_json::to_vec_pretty(&rows)?)?;
+    }
+    Ok(())
+}
+
+/// One synthetic image of `n` grains on a `side`² image, on 1 and 2 threads.
+fn one_size(a: &BenchArgs, side: usize, n: usize) -> Result<Vec<Row>> {
     let spec = SynthSpec {
         width: side,
         height: side,
@@ -93,8 +111,5 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         );
         rows.push(row);
     }
-    if let Some(p) = &a.json {
-        lbdem_core::atomic::write_atomic(p, &serde_json::to_vec_pretty(&rows)?)?;
-    }
-    Ok(())
+    Ok(rows)
 }
