@@ -91,23 +91,32 @@ pub fn quadratic_fit(x: &[f64], y: &[f64], x0: f64) -> Result<[f64; 3]> {
             "need at least three (x, y) pairs",
         ));
     }
-    // The design matrix [1, t, t^2] solved in the least-squares sense by SVD (rank-revealing:
-    // points at fewer than three distinct x cannot fix a parabola).
-    let a = DMatrix::from_fn(x.len(), 3, |i, j| (x[i] - x0).powi(j as i32));
+    // The design matrix [1, u, u^2] with u = t / max|t| solved in the least-squares sense by
+    // SVD (rank-revealing: points at fewer than three distinct x cannot fix a parabola). The
+    // scaling makes the relative rank tolerance mean the same in metres as in pixels: with t
+    // itself, t^2 of a scan in 10 nm steps fell below 1e-12 of the largest singular value.
+    let scale = x.iter().map(|&v| (v - x0).abs()).fold(0.0, f64::max);
+    let degenerate = || {
+        ImagingError::invalid(
+            "fit points",
+            x.len(),
+            "are degenerate (fewer than three distinct x)",
+        )
+    };
+    if !(scale > 0.0 && scale.is_finite()) {
+        return Err(degenerate());
+    }
+    let a = DMatrix::from_fn(x.len(), 3, |i, j| ((x[i] - x0) / scale).powi(j as i32));
     let b = DVector::from_column_slice(y);
     let svd = a.svd(true, true);
     let tol = 1e-12 * svd.singular_values.max();
     if svd.rank(tol) < 3 {
-        return Err(ImagingError::invalid(
-            "fit points",
-            x.len(),
-            "are degenerate (fewer than three distinct x)",
-        ));
+        return Err(degenerate());
     }
     let c = svd
         .solve(&b, tol)
         .map_err(|e| ImagingError::invalid("fit points", x.len(), e))?;
-    Ok([c[0], c[1], c[2]])
+    Ok([c[0], c[1] / scale, c[2] / (scale * scale)])
 }
 
 /// Result of the meniscus fit along a thickness line scan.
@@ -185,6 +194,36 @@ mod tests {
         // Two distinct x cannot fix a parabola.
         let err = quadratic_fit(&[1.0, 1.0, 2.0, 2.0], &[0.0, 0.1, 1.0, 1.1], 0.0).unwrap_err();
         assert!(err.to_string().contains("degenerate"), "{err}");
+    }
+
+    /// Line scans in metres: pixels of 1 um (t = x - x0 from 1e-6 to 1e-4 m) and of 10 nm
+    /// (1e-8 to 1e-6 m), so the columns of [1, t, t^2] span eight to sixteen decades. The rank
+    /// test must not call that degenerate (before t was scaled, the 10 nm scan was refused:
+    /// its t^2 column's singular value fell below 1e-12 of the largest), and the coefficients
+    /// come back to round-off.
+    #[test]
+    fn quadratic_fit_in_metres() {
+        for (dx, c1, c2, tol) in [(1e-6, -2.0e-3, 5.0e3, 2.5e-12), (1e-8, 3.0e-2, 4.0e5, 2.5e-11)] {
+            let (c0, x0) = (1.4e-4, 3.2e-3);
+            let x: Vec<f64> = (1..=100).map(|i| x0 + i as f64 * dx).collect();
+            let y: Vec<f64> = x
+                .iter()
+                .map(|&x| c0 + c1 * (x - x0) + c2 * (x - x0).powi(2))
+                .collect();
+            let c = quadratic_fit(&x, &y, x0).unwrap();
+            let rel: Vec<f64> = c
+                .iter()
+                .zip([c0, c1, c2])
+                .map(|(got, want)| ((got - want) / want).abs())
+                .collect();
+            println!("spacing {dx:e} m: relative errors {rel:?}");
+            // Measured, largest (the slope): 1.1e-12 at 1 um, 1.0e-11 at 10 nm; x - x0 itself
+            // carries a relative round-off of about 1e-16 x0 / (x - x0), which c1 inherits.
+            assert!(rel.iter().all(|&e| e < tol), "{c:?}: {rel:?}");
+            // Points at two x only are degenerate at this scale too.
+            let err = quadratic_fit(&[x0, x0, x0 + dx, x0 + dx], &[0.0, dx, dx, 2.0 * dx], x0);
+            assert!(err.unwrap_err().to_string().contains("degenerate"));
+        }
     }
 
     /// Su et al. (2020) Sect. 4.4: R ~ 100 um with gamma ~ 0.7 J/m^2 gives dp ~ -14.00 kPa (Eq. 23).
