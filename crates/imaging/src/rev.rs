@@ -193,8 +193,9 @@ impl Sat {
         Ok(if n == 0 { f64::NAN } else { s / n as f64 })
     }
 
-    /// One row `r` of the sliding-window REV mean (see [`Sat::rev_mean_into`]).
-    fn rev_row(&self, r: usize, side: usize, need: usize, orow: &mut [f64]) {
+    /// One row `r` of the sliding-window REV mean (see [`Sat::rev_mean_into`]); `need` is the
+    /// least number of finite pixels of a window with a mean.
+    pub(crate) fn rev_row(&self, r: usize, side: usize, need: usize, orow: &mut [f64]) {
         let (h, w) = self.dim();
         let lo = side / 2;
         let hi = side - lo;
@@ -229,7 +230,8 @@ impl Sat {
                 *o = slow(c);
             }
         }
-        for c in (0..ci0).chain(ci1..w) {
+        // A window wider than the image leaves no interior: ci0 may exceed w.
+        for c in (0..ci0.min(w)).chain(ci1..w) {
             orow[c] = slow(c);
         }
     }
