@@ -42,8 +42,10 @@ pub struct Study {
     /// (`atlas::run_pairs`).
     #[serde(default)]
     pub runs: Option<BTreeMap<String, PathBuf>>,
-    #[serde(default = "simplify_axis")]
-    pub axis: String,
+    /// The sweep's axis holding the simplifications (default "simplify"); sweeps only: with
+    /// `runs` each key names its simplification.
+    #[serde(default)]
+    pub axis: Option<String>,
     #[serde(default = "none")]
     pub reference: String,
     /// The result column of the sweep (of the runs' series), and the change in it a user accepts.
@@ -53,14 +55,13 @@ pub struct Study {
     pub why: String,
     /// A result column holding the time of the part each simplification acts on (e.g. the
     /// shear stage's `wall_seconds`, without the assembly every case repeats); default: the
-    /// case's whole wall time.
+    /// case's whole wall time. Sweeps only: a run's time is its stage.json's `wall_s`.
     #[serde(default)]
     pub time: Option<String>,
 }
 
-fn simplify_axis() -> String {
-    "simplify".into()
-}
+/// The axis a sweep varies simplifications along unless `axis` says otherwise.
+const SIMPLIFY_AXIS: &str = "simplify";
 fn none() -> String {
     "none".into()
 }
@@ -117,7 +118,7 @@ impl Stage for MinimalModels {
                     let shifts = paired_shifts(
                         &s.study,
                         &dir,
-                        &s.axis,
+                        s.axis.as_deref().unwrap_or(SIMPLIFY_AXIS),
                         &s.reference,
                         &s.result,
                         str_column,
@@ -338,6 +339,30 @@ fn check(p: &Params) -> Result<()> {
                 if s.sweep.is_some() { "both" } else { "neither" }
             );
         }
+        if s.runs.is_some() {
+            // Keys of a sweep that mean nothing for runs are refused rather than ignored.
+            let given = [
+                (
+                    "time",
+                    s.time.as_ref(),
+                    "a run's wall time is its stage.json's wall_s",
+                ),
+                (
+                    "axis",
+                    s.axis.as_ref(),
+                    "each key of runs names its simplification",
+                ),
+            ];
+            for (key, value, why) in given {
+                if let Some(v) = value {
+                    bail!(
+                        "minimal-models: study '{}': {key} = {v:?} is for a sweep, and this study gives runs ({why}); \
+                         remove {key}, or give sweep = \"DIR\" instead of runs",
+                        s.study
+                    );
+                }
+            }
+        }
         if !(s.tolerance > 0.0 && s.tolerance.is_finite()) {
             bail!(
                 "minimal-models: study '{}': tolerance = {}; give the change in {} a user accepts, a positive number",
@@ -383,7 +408,7 @@ mod tests {
                 study: "test cell".into(),
                 sweep: Some(sweep.clone()),
                 runs: None,
-                axis: simplify_axis(),
+                axis: None,
                 reference: none(),
                 result: "eps".into(),
                 tolerance: 0.004,
@@ -416,5 +441,29 @@ mod tests {
             .collect();
         assert_eq!(names, ["no-rolling"]);
         assert!(simplify::harmless_for(&v, "float").is_empty());
+    }
+
+    /// `time` and `axis` are a sweep's keys: beside `runs` each is refused, naming the study, the
+    /// key and the fix; the same study without it passes the check.
+    #[test]
+    fn sweep_keys_beside_runs_are_refused() {
+        let study = |extra: &str| -> Params {
+            toml::from_str(&format!(
+                "[[studies]]\nfamily = \"shear-cell\"\nstudy = \"fig 11\"\nresult = \"eps_vol_dem\"\n\
+                 tolerance = 0.0018\nwhy = \"a test\"\n{extra}\n\
+                 [studies.runs]\nnone = \"a\"\nno-liquid = \"b\"\n"
+            ))
+            .unwrap()
+        };
+        check(&study("")).unwrap();
+        for (line, key) in [("time = \"shear_wall\"", "time"), ("axis = \"simplify\"", "axis")] {
+            let e = check(&study(line)).unwrap_err().to_string();
+            assert!(
+                e.contains("study 'fig 11'")
+                    && e.contains(&format!("{key} = \""))
+                    && e.contains(&format!("remove {key}")),
+                "{e}"
+            );
+        }
     }
 }
