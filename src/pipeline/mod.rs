@@ -7,7 +7,7 @@ mod cache;
 pub mod provenance;
 pub mod schema;
 
-use crate::contract::{Interrupted, MANIFEST, StageContext, StageRecord, code_version};
+use crate::contract::{CHECKPOINT, Interrupted, MANIFEST, StageContext, StageRecord, code_version};
 use crate::registry::{self, Prepared, StageKind};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -86,12 +86,16 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
             lbdem_core::atomic::write_atomic(&key_file, key.as_bytes())?;
         }
     }
+    // What the record says: the stage continued a run only if asked to and its working
+    // directory held a checkpoint to continue from (a stage asked to resume a run killed before
+    // its first checkpoint starts from nothing, or refuses).
+    let resumed = ctx.resume && staging.join(CHECKPOINT).is_file();
     let mut wctx = ctx.with_out_dir(staging.clone());
     wctx.key = key.clone();
     // A panic is a bug, but even then the stage leaves nothing behind: it becomes an error here
     // and the working directory is removed below.
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        run_and_record(prepared, &wctx, key, inputs)
+        run_and_record(prepared, &wctx, key, inputs, resumed)
     }))
     .unwrap_or_else(|panic| {
         let why = panic
@@ -161,6 +165,7 @@ fn run_and_record(
     ctx: &StageContext,
     key: String,
     inputs: Vec<crate::contract::InputHash>,
+    resumed: bool,
 ) -> Result<StageRecord> {
     let (kind, params) = (prepared.kind.clone(), prepared.params_json.clone());
     let t0 = Instant::now();
@@ -176,7 +181,7 @@ fn run_and_record(
         inputs,
         wall_s: t0.elapsed().as_secs_f64(),
         cached: false,
-        resumed: ctx.resume,
+        resumed,
         output,
     };
     let json = serde_json::to_vec_pretty(&record)?;

@@ -224,3 +224,57 @@ fn a_panicking_stage_becomes_an_error_and_leaves_nothing_behind() {
         std::fs::read_dir(&ctx.out_dir).map(|d| d.count())
     );
 }
+
+/// `resumed` in the record says whether the stage continued a run, not whether it was asked
+/// to: asked to resume a run killed before its first checkpoint (its working directory holds
+/// the run key and nothing else), a stage starts from nothing and the record says false; with a
+/// checkpoint there, true.
+#[test]
+fn resumed_is_recorded_only_when_there_was_a_checkpoint_to_continue() {
+    let (_d, input, mut ctx) = setup();
+    let stage = || {
+        let mut p = Prepared::from_parts(
+            "test",
+            serde_json::json!({}),
+            vec![input.clone()],
+            |c: &StageContext| {
+                lbdem_core::atomic::write_atomic(&c.out_dir.join("a.txt"), b"x")?;
+                Ok(StageOutput {
+                    files: vec!["a.txt".into()],
+                    ..Default::default()
+                })
+            },
+        );
+        p.resumable = true;
+        p
+    };
+    let key = cache::cache_key(
+        "test",
+        &serde_json::json!({}),
+        &cache::hash_inputs(std::slice::from_ref(&input)).unwrap(),
+    );
+    let interrupted = |checkpoint: bool| {
+        let partial = ctx.out_dir.join(PARTIAL);
+        std::fs::create_dir_all(&partial).unwrap();
+        std::fs::write(partial.join(cache::KEY_FILE), &key).unwrap();
+        if checkpoint {
+            std::fs::write(partial.join(crate::contract::CHECKPOINT), b"{}").unwrap();
+        }
+    };
+    ctx.resume = true;
+    let on_disk = |ctx: &StageContext| -> StageRecord {
+        serde_json::from_slice(&std::fs::read(ctx.out_dir.join(MANIFEST)).unwrap()).unwrap()
+    };
+    interrupted(false);
+    let rec = execute(stage(), &ctx).unwrap();
+    assert!(
+        !rec.resumed && !on_disk(&ctx).resumed,
+        "a fresh run recorded as resumed"
+    );
+    interrupted(true);
+    let rec = execute(stage(), &ctx).unwrap();
+    assert!(
+        rec.resumed && on_disk(&ctx).resumed,
+        "a resumed run recorded as fresh"
+    );
+}
