@@ -214,13 +214,41 @@ fn dense_suspension_shear_follows_boyer_et_al() {
 }
 
 /// The flow curve: 400 spheres at φ = 0.40-0.55, St = 0.1, strain 5 (averaged over 1.5-5); a
-/// table of P/(η γ̇), σ_xy/(η γ̇) and μ against Boyer et al. (2011). Takes ~8 minutes.
+/// table of P/(η γ̇), σ_xy/(η γ̇) and μ against Boyer et al. (2011). Takes ~5-8 minutes.
+/// Asserts what the model shows over the whole curve (measured 2026-11-26, docs/dem3d.md):
+/// P/(η γ̇) and σ_xy/(η γ̇) rise with φ at every step (the smallest rise, 0.40 → 0.45, is 1.6×
+/// in P and 1.4× in σ_xy), μ falls with φ (1.83 → 0.60), and near jamming (φ = 0.53, 0.55) μ sits
+/// on Boyer's μ(I_v): measured −5.1 % and +2.4 %, tolerance 10 %. Below 0.53 the stresses are
+/// 2-3× under Boyer's (nearest-neighbour lubrication only), so no level is asserted there.
 #[test]
 #[ignore]
 fn flow_curve_against_boyer_et_al() {
-    for phi in [0.40, 0.45, 0.50, 0.53, 0.55] {
-        let f = shear_run(400, phi, 0.1, 1e6, 0.5, 0.5, 5.0, 1.5, 2);
-        print_row(&f);
+    let curve: Vec<Flow> = [0.40, 0.45, 0.50, 0.53, 0.55]
+        .into_iter()
+        .map(|phi| {
+            let f = shear_run(400, phi, 0.1, 1e6, 0.5, 0.5, 5.0, 1.5, 2);
+            print_row(&f);
+            f
+        })
+        .collect();
+    for w in curve.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        assert!(
+            b.p > a.p && b.shear > a.shear,
+            "stresses must rise from phi {} to {}",
+            a.phi,
+            b.phi
+        );
+        assert!(b.mu < a.mu, "mu must fall from phi {} to {}", a.phi, b.phi);
+    }
+    for f in curve.iter().filter(|f| f.phi > 0.52) {
+        let dev = f.mu / boyer_mu(boyer_iv(f.phi)) - 1.0;
+        assert!(
+            dev.abs() < 0.10,
+            "phi {}: mu {} off Boyer by {dev:+.3}",
+            f.phi,
+            f.mu
+        );
     }
 }
 
