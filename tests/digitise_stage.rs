@@ -5,6 +5,32 @@ use lbdem_grains::synth::{SynthSpec, generate};
 use std::path::Path;
 use std::process::Command;
 
+/// Column `name` of the CSV table at `path`, every cell a finite number. Read strictly: polars'
+/// default cast turns a cell that is not a number into null and `f64_column` turns that into NaN,
+/// which an assertion can then pass by accident (every comparison with NaN is false); here a
+/// malformed table fails the test, naming the file, column and row.
+fn finite_column(path: &Path, name: &str) -> Vec<f64> {
+    let df = lbdem::report::table::read_table(path).unwrap();
+    let c = df
+        .column(name)
+        .unwrap_or_else(|_| panic!("{} has no column '{name}'", path.display()))
+        .strict_cast(&polars::prelude::DataType::Float64)
+        .unwrap_or_else(|e| panic!("{}: column '{name}' is not all numbers: {e}", path.display()));
+    c.f64()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(k, v)| match v {
+            Some(x) if x.is_finite() => x,
+            _ => panic!(
+                "{}: column '{name}', data row {}: {v:?}, not a finite number",
+                path.display(),
+                k + 1
+            ),
+        })
+        .collect()
+}
+
 fn save_png(path: &Path, img: &ndarray::Array2<f64>) {
     let (h, w) = img.dim();
     let buf = image::GrayImage::from_fn(w as u32, h as u32, |x, y| {
@@ -61,8 +87,7 @@ fn cli_writes_the_assembly_with_its_header() {
     let csv = std::fs::read_to_string(out.join("particles.csv")).unwrap();
     assert_eq!(csv.lines().next(), Some("grain_id,x,y,r"));
     let path = out.join("particles.csv");
-    let df = lbdem::report::table::read_table(&path).unwrap();
-    let col = |n: &str| lbdem::report::table::f64_column(&df, n, &path).unwrap();
+    let col = |n: &str| finite_column(&path, n);
     let (ids, ys) = (col("grain_id"), col("y"));
     let n_grains = ids.iter().map(|&i| i as usize).max().unwrap();
     assert_eq!(n_grains, s.grains.len(), "grain count");

@@ -74,20 +74,89 @@ fn fake_run(dir: &Path, d: &[[f64; 3]], h: [[f64; 2]; 2], shift: [f64; 2]) -> Pa
     run
 }
 
-/// The last row of a table, every numeric column by name (text columns left out).
-fn csv_row(path: &Path) -> std::collections::HashMap<String, f64> {
+/// The last row of a table of numbers (agreement.csv), by column name.
+#[derive(Debug)]
+struct Row {
+    file: PathBuf,
+    values: std::collections::HashMap<String, f64>,
+}
+
+impl std::ops::Index<&str> for Row {
+    type Output = f64;
+    /// A value an assertion reads must be there and finite: NaN (a correlation of a constant
+    /// field, say) would make every comparison false and some assertions pass by accident.
+    fn index(&self, key: &str) -> &f64 {
+        match self.values.get(key) {
+            Some(v) if v.is_finite() => v,
+            v => panic!(
+                "{}: column '{key}' of the last row is {v:?}, not a finite number",
+                self.file.display()
+            ),
+        }
+    }
+}
+
+/// The last row of a table whose every column holds numbers, read strictly: polars' default
+/// cast turns a cell that is not a number into null and `f64_column` turns that into NaN, so a
+/// malformed table would read as NaN; here a cell that is not a number or is empty fails the test.
+fn csv_row(path: &Path) -> Row {
     let df = lbdem::report::table::read_table(path).unwrap();
-    df.get_column_names()
+    let values = df
+        .columns()
         .iter()
-        .filter_map(|h| {
-            let v = lbdem::report::table::f64_column(&df, h, path).ok()?;
-            Some((h.to_string(), *v.last()?))
+        .map(|c| {
+            let name = c.name().to_string();
+            let v = c
+                .strict_cast(&polars::prelude::DataType::Float64)
+                .unwrap_or_else(|e| panic!("{}: column '{name}' is not all numbers: {e}", path.display()));
+            let last = v
+                .f64()
+                .unwrap()
+                .iter()
+                .last()
+                .flatten()
+                .unwrap_or_else(|| panic!("{}: column '{name}': no last value", path.display()));
+            (name, last)
         })
-        .collect()
+        .collect();
+    Row {
+        file: path.to_path_buf(),
+        values,
+    }
+}
+
+/// `csv_row` refuses a word or an empty cell, and its rows refuse to give a NaN or a column
+/// they lack.
+#[test]
+fn the_row_reader_refuses_malformed_cells() {
+    let t = tempfile::tempdir().unwrap();
+    let p = |name: &str, text: &str| {
+        let f = t.path().join(name);
+        std::fs::write(&f, text).unwrap();
+        f
+    };
+    let fails = |f: &dyn Fn()| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(f))
+            .err()
+            .and_then(|e| e.downcast_ref::<String>().cloned())
+            .unwrap_or_default()
+    };
+    let good = csv_row(&p("good.csv", "a,b\n0,NaN\n1.5,NaN\n"));
+    assert_eq!(good["a"], 1.5);
+    for key in ["b", "c"] {
+        let e = fails(&|| {
+            let _ = good[key];
+        });
+        assert!(e.contains(&format!("column '{key}' of the last row")), "{e:?}");
+    }
+    let word = p("word.csv", "a,b\n0,1\n1,oops\n");
+    assert!(fails(&|| drop(csv_row(&word))).contains("column 'b' is not all numbers"));
+    let empty = p("empty.csv", "a,b\n0,1\n1,\n");
+    assert!(fails(&|| drop(csv_row(&empty))).contains("column 'b': no last value"));
 }
 
 /// synth run -> radiograph -> compare on the fake run in `dir`; the last row of agreement.csv.
-fn operators(dir: &Path, runs: &Path) -> std::collections::HashMap<String, f64> {
+fn operators(dir: &Path, runs: &Path) -> Row {
     let p = |name: &str, text: String| {
         let f = dir.join(name);
         std::fs::write(&f, text).unwrap();
