@@ -15,7 +15,7 @@ use lbdem_imaging::edge::{self, BulkPhase};
 use lbdem_imaging::profile::{self, ProfileAxis};
 use lbdem_imaging::rev::{self, Sat};
 use lbdem_imaging::{Roi, correct};
-use ndarray::{Array2, s};
+use ndarray::{Array2, Zip, s};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -703,16 +703,21 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
                 Some(e) => Some(profile::roi_profile(e.view(), spec.roi, spec.axis, "profiles.roi")?.1),
                 None => None,
             };
-            // The flag's share across the ROI: the profile of the ROI's flags alone.
-            let f = match near {
-                Some(f) => {
+            // The flag's share across the ROI: the profile of the ROI's flags alone, over the
+            // REVs with an eps_vol (as the summary's near_edge_fraction): an REV without one is
+            // neither near an edge nor away from it, so its flag is NaN and left out.
+            let f = match (near, &eps) {
+                (Some(f), Some(e)) => {
                     spec.roi.check("profiles.roi", f.dim())?;
                     let r = spec.roi;
-                    let sub = f.slice(s![r.y..r.y + r.h, r.x..r.x + r.w]).mapv(f64::from);
+                    let win = s![r.y..r.y + r.h, r.x..r.x + r.w];
+                    let sub = Zip::from(f.slice(win))
+                        .and(e.slice(win))
+                        .map_collect(|&f, &e| if e.is_finite() { f64::from(f) } else { f64::NAN });
                     let whole = Roi::new(0, 0, spec.roi.w, spec.roi.h);
                     Some(profile::roi_profile(sub.view(), whole, spec.axis, "profiles.roi")?.1)
                 }
-                None => None,
+                _ => None,
             };
             profs.push((pos, g, e, f));
         }
