@@ -5,6 +5,7 @@
 mod common;
 use common::run;
 use lbdem::report::table;
+use polars::prelude::DataType;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -13,14 +14,83 @@ fn repo(p: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
 }
 
+/// Column `name` of the CSV table at `csv` as text, every cell present (an empty cell, which
+/// `str_column` would turn into "", fails the test).
 fn column(csv: &Path, name: &str) -> Vec<String> {
     let df = table::read_table(csv).unwrap();
-    table::str_column(&df, name, csv).unwrap()
+    let c = df
+        .column(name)
+        .unwrap_or_else(|_| panic!("{} has no column '{name}'", csv.display()))
+        .strict_cast(&DataType::String)
+        .unwrap_or_else(|e| panic!("{}: column '{name}': {e}", csv.display()));
+    c.str()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            v.unwrap_or_else(|| panic!("{}: column '{name}', data row {}: empty", csv.display(), k + 1))
+                .to_string()
+        })
+        .collect()
 }
 
+/// Column `name` of the CSV table at `csv`, every cell a finite number. Read strictly: polars'
+/// default cast turns a cell that is not a number into null and `f64_column` turns that into NaN,
+/// which an assertion can then pass by accident (every comparison with NaN is false); here a
+/// malformed table fails the test, naming the file, column and row.
 fn numbers(csv: &Path, name: &str) -> Vec<f64> {
     let df = table::read_table(csv).unwrap();
-    table::f64_column(&df, name, csv).unwrap()
+    let c = df
+        .column(name)
+        .unwrap_or_else(|_| panic!("{} has no column '{name}'", csv.display()))
+        .strict_cast(&DataType::Float64)
+        .unwrap_or_else(|e| panic!("{}: column '{name}' is not all numbers: {e}", csv.display()));
+    c.f64()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(k, v)| match v {
+            Some(x) if x.is_finite() => x,
+            _ => panic!(
+                "{}: column '{name}', data row {}: {v:?}, not a finite number",
+                csv.display(),
+                k + 1
+            ),
+        })
+        .collect()
+}
+
+/// The readers above fail on a malformed table (a word, an empty cell or NaN where a number
+/// belongs; an empty text cell) and read a good one.
+#[test]
+fn the_table_readers_refuse_malformed_cells() {
+    let t = tempfile::tempdir().unwrap();
+    let csv = t.path().join("r.csv");
+    std::fs::write(&csv, "case,a,b,c,d\nx,1.5,1,NaN,2\n,2.5,oops,1,\n").unwrap();
+    assert_eq!(numbers(&csv, "a"), [1.5, 2.5]);
+    let fails = |f: &dyn Fn()| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(f))
+            .err()
+            .and_then(|e| e.downcast_ref::<String>().cloned())
+            .unwrap_or_default()
+    };
+    for (col, why) in [
+        ("b", "not all numbers"),
+        ("c", "row 1: Some(NaN)"),
+        ("d", "row 2: None"),
+    ] {
+        let e = fails(&|| {
+            numbers(&csv, col);
+        });
+        assert!(
+            e.contains(&format!("column '{col}'")) && e.contains(why),
+            "{col}: {e:?}"
+        );
+    }
+    let e = fails(&|| {
+        column(&csv, "case");
+    });
+    assert!(e.contains("column 'case', data row 2: empty"), "{e:?}");
 }
 
 /// sweeps/su2020-ci.toml as CI runs it (also under MPI: scripts/mpi-sweep-check.sh).
