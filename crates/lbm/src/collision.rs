@@ -19,6 +19,7 @@ macro_rules! unroll {
         $( { let $k: usize = $n; $body } )*
     };
 }
+pub(crate) use unroll;
 
 /// The collision operator of a run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -230,7 +231,7 @@ pub fn collide_block<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
 /// ρ, u = (Σ f c + F/2)/ρ (Leonardi Eqs. 9, 17) and |u|² of a block. Velocity components are
 /// summed with additions and subtractions only (c_ia ∈ {−1, 0, 1} is a compile-time constant).
 #[inline(always)]
-fn moments<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
+pub(crate) fn moments<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
     f: &[[T; W]; QMAX],
     p: &CollideParams<T>,
 ) -> Moments<T, W> {
@@ -479,10 +480,6 @@ fn trt_block_local<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
     let zero = T::default();
     let half = T::from_f64(0.5);
     let one = T::from_f64(1.0);
-    let three = T::from_f64(3.0);
-    let c45 = T::from_f64(4.5);
-    let c15 = T::from_f64(1.5);
-    let nine = T::from_f64(9.0);
     let mut rho = [zero; W];
     let mut j = [[zero; W]; 3];
     for i in 0..L::Q {
@@ -516,6 +513,27 @@ fn trt_block_local<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
             }
         }
     }
+    trt_relax_local::<L, T, W, FORCED>(f, p, r, Moments { rho, u, usq }, &uf)
+}
+
+/// The relaxation of `trt_block_local` from given moments and u·F (shared with the Bingham
+/// collider, which computes the moments first to get the shear rate).
+#[inline(always)]
+pub(crate) fn trt_relax_local<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
+    f: &mut [[T; W]; QMAX],
+    p: &CollideParams<T>,
+    r: &[NodeRates<T>; W],
+    m: Moments<T, W>,
+    uf: &[T; W],
+) -> Moments<T, W> {
+    let zero = T::default();
+    let half = T::from_f64(0.5);
+    let one = T::from_f64(1.0);
+    let three = T::from_f64(3.0);
+    let c45 = T::from_f64(4.5);
+    let c15 = T::from_f64(1.5);
+    let nine = T::from_f64(9.0);
+    let Moments { rho, u, usq } = m;
     {
         let w0 = T::from_f64(L::W[0]);
         for w in 0..W {
@@ -574,6 +592,17 @@ fn bgk_block_local<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
     r: &[NodeRates<T>; W],
 ) -> Moments<T, W> {
     let m = moments::<L, T, W, FORCED>(f, p);
+    bgk_relax_local::<L, T, W, FORCED>(f, p, r, m)
+}
+
+/// The relaxation of `bgk_block_local` from given moments (shared with the Bingham collider).
+#[inline(always)]
+pub(crate) fn bgk_relax_local<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
+    f: &mut [[T; W]; QMAX],
+    p: &CollideParams<T>,
+    r: &[NodeRates<T>; W],
+    m: Moments<T, W>,
+) -> Moments<T, W> {
     let one = T::from_f64(1.0);
     let three = T::from_f64(3.0);
     let c45 = T::from_f64(4.5);

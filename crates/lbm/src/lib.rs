@@ -4,13 +4,15 @@
 //! with Guo forcing ([`collision`]), a fused stream-collide kernel over structure-of-arrays storage
 //! in f32 or f64 ([`kernel`]), halfway bounce-back on stationary and moving walls with the
 //! momentum-exchange force and torque, Zou-He velocity and pressure faces, periodic faces, and a
-//! stepper that stops at the first node leaving the accepted range with a diagnosis ([`stepper`]).
+//! stepper that stops at the first node leaving the accepted range with a diagnosis ([`stepper`]),
+//! and Bingham plastic rheology by a local relaxation time in the same kernels ([`bingham`]).
 //! Pure computation: no file I/O; units are converted in `lbdem_core::units::lattice`.
 
 // Kernels index several parallel arrays (velocities, weights, populations) by direction: an index
 // loop says that more plainly than zipped iterators.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bingham;
 pub mod cases;
 pub mod collision;
 pub mod diagnosis;
@@ -26,6 +28,7 @@ pub mod stepper;
 pub mod stepper_aa;
 pub mod zouhe;
 
+pub use bingham::{Bingham, BinghamRates};
 pub use collision::{Collider, Collision, LocalRates, NodeRates};
 pub use diagnosis::BadNode;
 pub use domain::{Domain, Face, Motion};
@@ -54,6 +57,12 @@ pub enum LbmError {
          in node order (x + nx (y + ny z))"
     )]
     LocalTauLength { got: usize, nodes: usize },
+    #[error("Bingham parameter {name} = {value}: {fix}")]
+    Bingham {
+        name: &'static str,
+        value: f64,
+        fix: String,
+    },
     #[error("TRT magic parameter = {magic} must be > 0; use 0.25 (stability) or 3/16 (exact walls)")]
     Magic { magic: f64 },
     #[error("unsupported set-up: {0}")]

@@ -27,6 +27,8 @@ pub trait Real:
     /// explicitly where the kernels want it, so every code path (blocks of nodes, single nodes,
     /// both kernels) rounds the same way: results stay bitwise reproducible.
     fn mul_add(self, a: Self, b: Self) -> Self;
+    /// Square root (IEEE, correctly rounded: the same bits on every code path).
+    fn sqrt(self) -> Self;
     /// Bit w set unless `lo < rho[w] < hi` and `usq[w] < um` (so NaN sets it): the kernels' range
     /// check of a block of B nodes. With AVX-512 it is three masked vector compares; left to
     /// itself the compiler split this reduction into scalar and part-width pieces that cost as
@@ -68,6 +70,10 @@ impl Real for f64 {
         f64::mul_add(self, a, b)
     }
     #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
     fn bad_block<const B: usize>(rho: &[Self; B], usq: &[Self; B], lo: Self, hi: Self, um: Self) -> u32 {
         #[cfg(target_arch = "x86_64")]
         if avx512() {
@@ -91,6 +97,10 @@ impl Real for f32 {
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         f32::mul_add(self, a, b)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
     }
     #[inline(always)]
     fn bad_block<const B: usize>(rho: &[Self; B], usq: &[Self; B], lo: Self, hi: Self, um: Self) -> u32 {

@@ -4,6 +4,7 @@
 //! fused stream-collide on a caller-chosen rayon pool, and the instability check.
 
 use crate::LbmError;
+use crate::bingham::{Bingham, BinghamRates};
 use crate::collision::{CollideParams, Collider, Collision, LocalRates, NodeRates, equilibrium, local_rates};
 use crate::diagnosis::BadNode;
 use crate::domain::{Domain, FLUID, Face, Motion};
@@ -108,6 +109,9 @@ pub struct Stepper<L: Lattice, T: Real> {
     params: CollideParams<T>,
     /// Per-node rates (`set_local_tau`) and the τ they came from (diagnosis).
     local: Option<(Vec<NodeRates<T>>, Vec<f64>)>,
+    /// Bingham rheology (`set_bingham`) and τ per node of the last step that asked for output.
+    bingham: Option<(Bingham, BinghamRates<T>)>,
+    tau_field: Vec<f64>,
     plan: Plan,
     other: Vec<T>,
     row_good: Vec<bool>,
@@ -246,6 +250,8 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             settings,
             params,
             local: None,
+            bingham: None,
+            tau_field: Vec::new(),
             plan: Plan::default(),
             other: vec![T::default(); fluid.f.len()],
             row_good: vec![true; dom.n[1] * dom.n[2]],
@@ -271,6 +277,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
     /// of collision (BGK, or TRT with its magic Λ): the seam of local-τ rheology (Bingham,
     /// Leonardi et al. 2014 Eq. 8). May be called between any two steps; equal values everywhere
     /// give the uniform run bit for bit. Refuses a τ ≤ ½ or a length other than the node count.
+    /// Replaces Bingham rheology if it was on.
     pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), LbmError> {
         let nodes = self.other.len() / L::Q;
         self.local = Some(make_local::<T>(
@@ -279,10 +286,39 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             tau,
             nodes,
         )?);
+        self.bingham = None;
         Ok(())
     }
 
-    /// Back to the settings' uniform τ.
+    /// Bingham plastic rheology from the next step on (`Some`), or back to the settings' τ
+    /// (`None`): every node's τ from its own shear rate every step, inside the kernel
+    /// (`bingham`, Leonardi et al. 2014 Eqs. 27-30), BGK or TRT as the settings say. Replaces
+    /// per-node τ if it was set. No state is added: a checkpoint of the `Fluid` still resumes bit
+    /// for bit (set the same Bingham on the new stepper).
+    pub fn set_bingham(&mut self, bingham: Option<Bingham>) -> Result<(), LbmError> {
+        self.bingham = match bingham {
+            Some(b) => Some((
+                b,
+                BinghamRates::new(&b, &self.settings.collision, self.settings.force)?,
+            )),
+            None => None,
+        };
+        self.clear_local_tau();
+        Ok(())
+    }
+
+    /// The Bingham parameters in use, if any.
+    pub fn bingham(&self) -> Option<&Bingham> {
+        self.bingham.as_ref().map(|(b, _)| b)
+    }
+
+    /// τ of every node on the last step that was given a `Macro` to fill, with Bingham on
+    /// (node order; solid and inactive nodes NaN). `None` before such a step.
+    pub fn bingham_tau(&self) -> Option<&[f64]> {
+        (self.bingham.is_some() && !self.tau_field.is_empty()).then_some(self.tau_field.as_slice())
+    }
+
+    /// Back to the settings' uniform τ (Bingham stays on if set).
     pub fn clear_local_tau(&mut self) {
         self.local = None;
         self.params.bgk = self
@@ -330,9 +366,33 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
         let limits = self.settings.limits.in_precision::<T>();
         let forced = self.settings.force.iter().any(|&x| x != 0.0);
         let dst = SyncPtr(self.other.as_mut_ptr());
+        let tau_out = match (&self.bingham, &out) {
+            (Some(_), Some(_)) => {
+                self.tau_field.clear();
+                self.tau_field.resize(n, f64::NAN);
+                Some(SyncPtr(self.tau_field.as_mut_ptr()))
+            }
+            _ => None,
+        };
         let (dom, plan, motions) = (&fluid.domain, &self.plan, &self.motions);
-        match &self.local {
-            None => {
+        match (&self.bingham, &self.local) {
+            (Some((_, rates)), _) => {
+                let ctx = Ctx {
+                    dom,
+                    plan,
+                    src: &fluid.f,
+                    dst,
+                    coll: BinghamRates {
+                        tau: tau_out,
+                        ..*rates
+                    },
+                    motions,
+                    limits,
+                    out,
+                };
+                run_rows::<L, T, _>(&mut self.row_good, &ctx, forced);
+            }
+            (None, None) => {
                 let ctx = Ctx {
                     dom,
                     plan,
@@ -345,7 +405,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
                 };
                 run_rows::<L, T, _>(&mut self.row_good, &ctx, forced);
             }
-            Some((rates, _)) => {
+            (None, Some((rates, _))) => {
                 let ctx = Ctx {
                     dom,
                     plan,
@@ -429,9 +489,11 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
             if lim.accepts(rho, u) {
                 continue;
             }
-            let tau = match &self.local {
-                Some((_, t)) => t[idx],
-                None => self.settings.collision.tau(),
+            let tau = match (&self.local, &self.bingham) {
+                (Some((_, t)), _) => t[idx],
+                // the smallest τ the clamp allows: the one a blow-up is likeliest to come from
+                (None, Some((b, _))) => b.tau_min,
+                (None, None) => self.settings.collision.tau(),
             };
             return BadNode {
                 step: fluid.step,

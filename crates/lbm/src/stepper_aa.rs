@@ -5,6 +5,7 @@
 //! here (use `Stepper`). Forces are refreshed every step from whichever layout the array is in.
 
 use crate::LbmError;
+use crate::bingham::{Bingham, BinghamRates};
 use crate::collision::{CollideParams, LocalRates, NodeRates};
 use crate::diagnosis::BadNode;
 use crate::domain::{Face, Motion};
@@ -36,6 +37,9 @@ pub struct StepperAa<L: Lattice, T: Real> {
     params: CollideParams<T>,
     /// Per-node rates (`set_local_tau`) and the τ they came from (diagnosis).
     local: Option<(Vec<NodeRates<T>>, Vec<f64>)>,
+    /// Bingham rheology (`set_bingham`) and τ per node of the last step that asked for output.
+    bingham: Option<(Bingham, BinghamRates<T>)>,
+    tau_field: Vec<f64>,
     /// Nodes of the lattice.
     nodes: usize,
     plan: Plan,
@@ -165,6 +169,8 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             settings,
             params: CollideParams::new(&settings.collision, settings.force)?,
             local: None,
+            bingham: None,
+            tau_field: Vec::new(),
             nodes: n,
             plan: Plan::build::<L>(dom, fluid.obstacles.len()),
             layout,
@@ -219,7 +225,8 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         Ok(out)
     }
 
-    /// Relax node x with τ⁺ = `tau[x]` (node order); see `Stepper::set_local_tau`.
+    /// Relax node x with τ⁺ = `tau[x]` (node order); see `Stepper::set_local_tau`. Replaces
+    /// Bingham rheology if it was on.
     pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), LbmError> {
         let nodes = self.nodes();
         self.local = Some(make_local::<T>(
@@ -228,7 +235,34 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             tau,
             nodes,
         )?);
+        self.bingham = None;
         Ok(())
+    }
+
+    /// Bingham plastic rheology from the next step on, or back to the settings' τ; see
+    /// `Stepper::set_bingham` (same kernel arithmetic: both steppers give the same bits). No
+    /// state is added: `export` after an even number of steps is still the whole state.
+    pub fn set_bingham(&mut self, bingham: Option<Bingham>) -> Result<(), LbmError> {
+        self.bingham = match bingham {
+            Some(b) => Some((
+                b,
+                BinghamRates::new(&b, &self.settings.collision, self.settings.force)?,
+            )),
+            None => None,
+        };
+        self.clear_local_tau();
+        Ok(())
+    }
+
+    /// The Bingham parameters in use, if any.
+    pub fn bingham(&self) -> Option<&Bingham> {
+        self.bingham.as_ref().map(|(b, _)| b)
+    }
+
+    /// τ of every node on the last step that was given a `Macro` to fill, with Bingham on
+    /// (node order; solid and inactive nodes NaN). `None` before such a step.
+    pub fn bingham_tau(&self) -> Option<&[f64]> {
+        (self.bingham.is_some() && !self.tau_field.is_empty()).then_some(self.tau_field.as_slice())
     }
 
     /// Back to the settings' uniform τ.
@@ -279,8 +313,32 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             self.layout,
             self.partition,
         );
-        match &self.local {
-            None => {
+        let tau_out = match (&self.bingham, &out) {
+            (Some(_), Some(_)) => {
+                self.tau_field.clear();
+                self.tau_field.resize(n, f64::NAN);
+                Some(SyncPtr(self.tau_field.as_mut_ptr()))
+            }
+            _ => None,
+        };
+        match (&self.bingham, &self.local) {
+            (Some((_, rates)), _) => {
+                let ctx = CtxAa {
+                    dom,
+                    plan,
+                    f,
+                    layout,
+                    coll: BinghamRates {
+                        tau: tau_out,
+                        ..*rates
+                    },
+                    motions,
+                    limits,
+                    out,
+                };
+                run_rows_aa::<L, T, _>(&mut self.bad, &ctx, partition, odd, forced);
+            }
+            (None, None) => {
                 let ctx = CtxAa {
                     dom,
                     plan,
@@ -293,7 +351,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
                 };
                 run_rows_aa::<L, T, _>(&mut self.bad, &ctx, partition, odd, forced);
             }
-            Some((rates, _)) => {
+            (None, Some((rates, _))) => {
                 let ctx = CtxAa {
                     dom,
                     plan,
@@ -316,9 +374,11 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         if let Some((r, Some((x, rho, u)))) = self.bad.iter().enumerate().find(|(_, b)| b.is_some()) {
             let ny = fluid.domain.n[1];
             let node = [*x, r % ny, r / ny];
-            let tau = match &self.local {
-                Some((_, t)) => t[fluid.domain.index(node[0], node[1], node[2])],
-                None => self.settings.collision.tau(),
+            let tau = match (&self.local, &self.bingham) {
+                (Some((_, t)), _) => t[fluid.domain.index(node[0], node[1], node[2])],
+                // the smallest τ the clamp allows (as `Stepper::diagnose`)
+                (None, Some((b, _))) => b.tau_min,
+                (None, None) => self.settings.collision.tau(),
             };
             return Err(BadNode {
                 step: fluid.step,
