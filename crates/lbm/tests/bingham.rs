@@ -551,37 +551,3 @@ fn bingham_parameters_are_checked() {
     assert!(Bingham::leonardi(0.05, 1e-5, 1.0).is_ok());
     assert!(Bingham::leonardi(1.5, 1e-5, 1.0).is_err(), "tau_pl = 5 > 3.5");
 }
-
-/// Indicative cost of the Bingham collider against the Newtonian kernel on the same case (AA,
-/// D2Q9 BGK f64, 256 x 192 periodic, in cache, current pool): not a benchmark (issue 20 item 5).
-/// `cargo test -p lbdem-lbm --test bingham -- --ignored --nocapture indicative`
-#[test]
-#[ignore]
-fn indicative_cost_ratio() {
-    let n = [256, 192, 1];
-    let dom = Domain::new(n, [Face::Periodic; 6]);
-    let s = settings(Collision::Bgk { tau: 0.65 }, [1e-6, 0.0, 0.0]);
-    let time = |bingham: bool| {
-        let mut fl = Fluid::<D2Q9, f64>::new(dom.clone(), Vec::new());
-        fl.init_equilibrium(|p| (1.0, [0.01 * (p[1] as f64 / 30.0).sin(), 0.0, 0.0]));
-        let mut st = StepperAa::new(&mut fl, s).unwrap();
-        if bingham {
-            st.set_bingham(Some(busy_bingham())).unwrap();
-        }
-        let mut best = f64::INFINITY;
-        for _ in 0..5 {
-            let t0 = std::time::Instant::now();
-            for _ in 0..50 {
-                st.step(&mut fl, None).unwrap();
-            }
-            best = best.min(t0.elapsed().as_secs_f64());
-        }
-        (n[0] * n[1] * 50) as f64 / best / 1e6
-    };
-    let (newt, bing) = (time(false), time(true));
-    eprintln!(
-        "indicative: Newtonian {newt:.0} MLUPS, Bingham {bing:.0} MLUPS, cost ratio {:.2}",
-        newt / bing
-    );
-    assert!(newt > 0.0 && bing > 0.0);
-}
