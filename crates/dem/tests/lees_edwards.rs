@@ -126,6 +126,8 @@ fn a_pair_across_the_sheared_face_matches_the_pair_inside_the_box() {
     let m = le.spheres.mass[0];
     let p = SphereStepParams::new(law.max_time_step(a, m).dt, 0.05);
     let (mut st_le, mut st_mid) = (SphereStepper::new(), SphereStepper::new());
+    st_le.record_contacts(true);
+    st_mid.record_contacts(true);
     let mut worst_state = 0.0f64;
     let mut sliding = 0;
     // Forces compared on the scale of the largest one of the run.

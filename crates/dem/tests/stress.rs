@@ -48,9 +48,17 @@ fn dipole_stress_of_a_compressed_lattice_equals_the_wall_load() {
     }
     let m = sys.spheres.mass[0];
     let p = SphereStepParams::new(law.max_time_step(A, m).dt, 0.1 * A);
+    // Recording is off by default: a step leaves no records, and costs none.
+    let mut off = SphereStepper::new();
+    let mut copy = sys.clone();
+    off.step(&p, &law, &mut copy).unwrap();
+    assert!(off.contacts().is_empty());
     let mut st = SphereStepper::new();
+    st.record_contacts(true);
     assert!(st.contacts().is_empty());
     st.step(&p, &law, &mut sys).unwrap();
+    // Recording changes no number of the run.
+    assert_eq!(copy.spheres.force, sys.spheres.force);
     let rec = st.contacts();
     // 3 pairs per sphere (x, y, z neighbours; z only between layers: 18), 9 spheres on each wall.
     let pairs = rec.iter().filter(|c| matches!(c.j, Partner::Sphere(_))).count();
@@ -126,6 +134,7 @@ fn lubrication_force_is_reported_as_hydrodynamic() {
     let m = sys.spheres.mass[0];
     let dt = law.max_time_step(A, m).dt;
     let mut st = SphereStepper::new();
+    st.record_contacts(true);
     st.step(&SphereStepParams::new(dt, 0.1 * A), &law, &mut sys)
         .unwrap();
     let rec = st.contacts();
@@ -145,4 +154,26 @@ fn lubrication_force_is_reported_as_hydrodynamic() {
     assert_eq!(sigma, dipole_stress(rec, l * l * l, false));
     // The squeeze film resists the approach as a contact would: compressive (positive).
     assert!(sigma[0][0] > 0.0, "{sigma:?}");
+}
+
+/// A step that fails part way (here the cell list refusing a sphere that drifted out of the box
+/// on an open axis) leaves no records behind: the last ones are not this state's.
+#[test]
+fn a_failed_step_leaves_no_records() {
+    let law = LinearSpring::ness(200.0, 0.5, 0.3);
+    let dom = Domain3::new(Vec3::ZERO, Vec3::new(0.01, 0.01, 0.01), [false; 3]).unwrap();
+    let mut sys = SphereSystem::new(dom);
+    let c = Vec3::new(0.005, 0.005, 0.005);
+    sys.add_sphere(c, Vec3::ZERO, Vec3::ZERO, A, RHO).unwrap();
+    sys.add_sphere(c + Vec3::new(1.9 * A, 0.0, 0.0), Vec3::ZERO, Vec3::ZERO, A, RHO)
+        .unwrap();
+    let m = sys.spheres.mass[0];
+    let p = SphereStepParams::new(law.max_time_step(A, m).dt, 0.1 * A);
+    let mut st = SphereStepper::new();
+    st.record_contacts(true);
+    st.step(&p, &law, &mut sys).unwrap();
+    assert_eq!(st.contacts().len(), 1);
+    sys.spheres.vel[0] = Vec3::new(0.0, 0.0, 1.0 / p.dt);
+    assert!(st.step(&p, &law, &mut sys).is_err());
+    assert!(st.contacts().is_empty());
 }

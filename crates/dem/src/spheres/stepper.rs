@@ -54,8 +54,11 @@ pub struct SphereStepper<L: SphereLaw> {
     new_hist: Histories,
     /// The (dt, law, sphere count, frozen count) last checked.
     checked: Option<(f64, L, usize, usize)>,
-    /// Interactions of the last force evaluation ([`Self::contacts`]).
+    /// Interactions of the last force evaluation ([`Self::contacts`]), kept only when
+    /// `record` is on.
     records: Vec<ContactForce>,
+    /// Whether force evaluations fill `records` ([`Self::record_contacts`]; off by default).
+    record: bool,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
@@ -68,6 +71,7 @@ impl<L: SphereLaw> Default for SphereStepper<L> {
             new_hist: Histories::default(),
             checked: None,
             records: Vec::new(),
+            record: false,
             rebuilds: 0,
         }
     }
@@ -89,10 +93,22 @@ impl<L: SphereLaw> SphereStepper<L> {
         Self::default()
     }
 
+    /// Turn the contact records of [`Self::contacts`] on or off (off by default: recording
+    /// costs a comparison and a push per interaction every step). Turning it off drops the
+    /// records held.
+    pub fn record_contacts(&mut self, on: bool) {
+        self.record = on;
+        if !on {
+            self.records.clear();
+        }
+    }
+
     /// Every interaction that exerted a force in the last force evaluation (pairs in list
     /// order, then sphere-wall contacts; the end of the last step, or the priming at step 0),
     /// with its contact point, branch vector and force, for stress sums
-    /// ([`super::dipole_stress`]). Empty before this stepper's first step.
+    /// ([`super::dipole_stress`]). Only while recording is on ([`Self::record_contacts`]):
+    /// with recording off (the default) this is always empty. Empty before this stepper's
+    /// first step and after a step that returned an error.
     pub fn contacts(&self) -> &[ContactForce] {
         &self.records
     }
@@ -141,11 +157,21 @@ impl<L: SphereLaw> SphereStepper<L> {
     }
 
     /// Advance `sys` by one step of `p.dt` under `law`.
+    ///
+    /// # Errors
+    ///
+    /// Parameters and state are checked before anything moves: such an error leaves `sys`
+    /// untouched. An error from later in the step (the cell list refusing the drifted
+    /// positions, or a non-finite state after the step) leaves `sys` part way through it —
+    /// positions, velocities, time and Lees-Edwards offset advanced, forces stale — so it is
+    /// not fit to step on: restore it from a checkpoint. The contact records are empty after
+    /// any error.
     pub fn step(&mut self, p: &SphereStepParams, law: &L, sys: &mut SphereSystem) -> Result<(), SphereError> {
         self.step_with(p, law, sys, &mut NoHook)
     }
 
-    /// Advance `sys` by one step of `p.dt` under `law`, with the user forces of `hook`.
+    /// Advance `sys` by one step of `p.dt` under `law`, with the user forces of `hook`. Errors
+    /// as for [`Self::step`].
     pub fn step_with(
         &mut self,
         p: &SphereStepParams,
@@ -153,6 +179,8 @@ impl<L: SphereLaw> SphereStepper<L> {
         sys: &mut SphereSystem,
         hook: &mut impl SphereForceHook,
     ) -> Result<(), SphereError> {
+        // Records of a step that fails are never left to look current.
+        self.records.clear();
         self.check(p, law, sys)?;
         if sys.step == 0 {
             // Prime F(0): the opening half kick needs the forces of the initial state.
@@ -188,7 +216,11 @@ impl<L: SphereLaw> SphereStepper<L> {
             w.point += w.vel * dt;
         }
         sys.time += dt;
-        self.refresh_list(p.skin, law, sys)?;
+        if let Err(e) = self.refresh_list(p.skin, law, sys) {
+            // The priming's records (step 0) are not this step's.
+            self.records.clear();
+            return Err(e);
+        }
         self.forces(p, law, sys, hook);
         // Closing half kick.
         for k in 0..n {
@@ -209,6 +241,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         if let Some(k) =
             (0..n).find(|&k| !(s.pos[k].is_finite() && s.vel[k].is_finite() && s.omega[k].is_finite()))
         {
+            self.records.clear();
             return Err(SphereError::NonFinite {
                 sphere: k,
                 step: sys.step - 1,
@@ -333,7 +366,7 @@ impl<L: SphereLaw> SphereStepper<L> {
                 dt: p.dt,
             };
             let out = law.force(&it, h);
-            if out != Response::default() {
+            if self.record && out != Response::default() {
                 self.records.push(ContactForce {
                     i: pair[0],
                     j: Partner::Sphere(pair[1]),
@@ -388,7 +421,7 @@ impl<L: SphereLaw> SphereStepper<L> {
                         dt: p.dt,
                     };
                     let out = law.force(&it, h);
-                    if out != Response::default() {
+                    if self.record && out != Response::default() {
                         self.records.push(ContactForce {
                             i: k as u32,
                             j: Partner::Wall(w as u32),
