@@ -154,16 +154,26 @@ impl Domain3 {
     }
 
     /// Wrap a position and its velocity into the box: on a Lees-Edwards box a crossing of a y
-    /// face shifts x by ∓ the offset and v_x by ∓ γ̇ L_y per box crossed; then [`Self::wrap`].
+    /// face shifts x by ∓ the offset and v_x by ∓ γ̇ L_y per box crossed; then [`Self::wrap`]
+    /// (which then finds y inside the box and leaves it alone).
     #[inline]
     pub fn wrap_moving(&self, mut p: Vec3, mut v: Vec3) -> (Vec3, Vec3) {
         if let Some(le) = self.shear {
-            let ly = self.size().y;
-            if !(p.y >= self.lo.y && p.y < self.hi.y) && p.y.is_finite() {
-                let k = ((p.y - self.lo.y) / ly).floor();
+            let (lo, hi, ly) = (self.lo.y, self.hi.y, self.size().y);
+            if !(p.y >= lo && p.y < hi) && p.y.is_finite() {
+                let k = ((p.y - lo) / ly).floor();
                 p.y -= k * ly;
                 p.x -= k * le.offset;
                 v.x -= k * le.rate * ly;
+                // The shift may round onto an end: y just below lo plus L_y gives exactly hi.
+                // Keep the k crossings applied to x and v and put y at the nearest point inside
+                // (within rounding of the exact one); a plain wrap of hi to lo would undo the
+                // crossing in y alone.
+                if p.y >= hi {
+                    p.y = hi.next_down();
+                } else if p.y < lo {
+                    p.y = lo;
+                }
             }
         }
         (self.wrap(p), v)
@@ -294,7 +304,36 @@ mod tests {
             "{p2:?} {v2:?}"
         );
         // Offsets outside [0, L_x) are refused.
-        d.shear.as_mut().unwrap().offset = lx;
-        assert!(d.check_shear().is_err());
+        let mut e = d;
+        e.shear.as_mut().unwrap().offset = lx;
+        assert!(e.check_shear().is_err());
+        // Just below the bottom face: lo - tiny + L_y rounds to exactly hi. The sphere crosses
+        // once (x by +s, v_x by +γ̇ L_y) and lands at the top, not back at lo with the shift
+        // (which put it s away from where it was, moving γ̇ L_y too fast).
+        let (vx, rate) = (0.3, 0.5);
+        for y in [-1e-300, -f64::MIN_POSITIVE, -1e-17] {
+            let (p, v) = d.wrap_moving(Vec3::new(1.0, y, 0.5), Vec3::new(vx, 0.0, 0.0));
+            assert!(p.y >= 0.0 && p.y < ly && p.y > ly - 1e-15, "{y}: {p:?}");
+            assert!(
+                (p.x - (1.0 + s)).abs() < 1e-15 && v.x == vx + rate * ly,
+                "{y}: {p:?} {v:?}"
+            );
+            // Its neighbour just above the bottom face sees it where it was, at its velocity.
+            let q = Vec3::new(1.0, 1e-9, 0.5);
+            let (dd, dv) = d.min_image_moving(p - q);
+            assert!(
+                dd.x.abs() < 1e-14 && (dd.y + 1e-9).abs() < 1e-14 && (v.x + dv.x - vx).abs() < 1e-15,
+                "{y}: {dd:?} {dv:?}"
+            );
+        }
+        // The same with lo away from 0.
+        let (lo, hi) = (0.7355621288699867, 3.6571500849874647);
+        let d = Domain3::new(Vec3::new(lo, lo, lo), Vec3::new(hi, hi, hi), [true; 3])
+            .unwrap()
+            .with_lees_edwards(rate)
+            .unwrap();
+        let (p, v) = d.wrap_moving(Vec3::new(1.0, lo.next_down(), 1.0), Vec3::ZERO);
+        assert!(p.y >= lo && p.y < hi && p.y > hi - 1e-15, "{p:?}");
+        assert!(p.x == 1.0 && v.x == rate * (hi - lo), "{p:?} {v:?}");
     }
 }
