@@ -209,3 +209,58 @@ fn sheared_checkpoint_resumes_bit_for_bit() {
         serde_json::to_string(&whole).unwrap()
     );
 }
+
+/// The Verlet list on a Lees-Edwards box: spheres at rest (no affine profile) in two rows just
+/// inside the bottom and top faces of a fast-sheared box (γ̇ L_y = 2, 4 spheres a row, radius
+/// 0.05, 0.06 apart across the face in y) are reached only by the images sliding past along x,
+/// so nothing moves a sphere before the first collision: only the offset term of the skin check
+/// can rebuild the list in time. The run with a skin must match, bit for bit, a run whose list
+/// is rebuilt every step (its reference positions dropped before each step, so the rebuild does
+/// not rest on the skin check under test). Measured: equal at every step; with the offset term
+/// taken out of the check the run with the skin misses the first contact (forces differ at it).
+#[test]
+fn verlet_list_follows_the_sliding_images() {
+    let (lx, ly, lz, rate, a) = (2.0, 1.0, 0.5, 2.0, 0.05);
+    let dom = Domain3::new(Vec3::ZERO, Vec3::new(lx, ly, lz), [true; 3])
+        .unwrap()
+        .with_lees_edwards(rate)
+        .unwrap();
+    let mut sys = SphereSystem::new(dom);
+    for k in 0..4 {
+        let x = 0.5 * k as f64;
+        sys.add_sphere(Vec3::new(x + 0.25, 0.03, 0.25), Vec3::ZERO, Vec3::ZERO, a, 1.0)
+            .unwrap();
+        sys.add_sphere(Vec3::new(x, ly - 0.03, 0.25), Vec3::ZERO, Vec3::ZERO, a, 1.0)
+            .unwrap();
+    }
+    let law = LinearSpring::ness(100.0, 0.5, 0.5);
+    let dt = 0.5 * law.max_time_step(a, sys.spheres.mass[0]).dt;
+    let p = SphereStepParams::new(dt, 0.02);
+    let (mut sa, mut sb) = (sys.clone(), sys);
+    let (mut ta, mut tb) = (SphereStepper::new(), SphereStepper::new());
+    // Two passes of the images along the whole box.
+    let steps = (2.0 * lx / (rate * ly * dt)).ceil() as usize;
+    let (mut first_touch, mut f_max) = (None, 0.0f64);
+    for n in 0..steps {
+        ta.step(&p, &law, &mut sa).unwrap();
+        // A list without reference positions is rebuilt.
+        sb.contacts.list_ref.clear();
+        tb.step(&p, &law, &mut sb).unwrap();
+        assert_eq!(sa.spheres.force, sb.spheres.force, "step {n}");
+        assert_eq!(sa.spheres.pos, sb.spheres.pos, "step {n}");
+        assert_eq!(sa.spheres.vel, sb.spheres.vel, "step {n}");
+        let f = sb.spheres.force.iter().map(|f| f.norm()).fold(0.0, f64::max);
+        if f > 0.0 && first_touch.is_none() {
+            first_touch = Some(n);
+        }
+        f_max = f_max.max(f);
+    }
+    println!(
+        "{steps} steps, first contact at step {first_touch:?}, largest force {f_max:.2e}; list \
+         rebuilds {} with the skin check, {} forced",
+        ta.rebuilds, tb.rebuilds
+    );
+    // The first contact comes after the list with the skin was built, and was caught.
+    assert!(first_touch.is_some_and(|n| n > 10), "{first_touch:?}");
+    assert!(ta.rebuilds > 1 && ta.rebuilds < tb.rebuilds / 4);
+}
