@@ -264,3 +264,51 @@ fn verlet_list_follows_the_sliding_images() {
     assert!(first_touch.is_some_and(|n| n > 10), "{first_touch:?}");
     assert!(ta.rebuilds > 1 && ta.rebuilds < tb.rebuilds / 4);
 }
+
+/// A state with a sphere outside the box on a periodic axis (a hand-edited or corrupt
+/// checkpoint) is refused, naming the sphere, the axis, the value and the fix; the stepper
+/// refuses it before moving anything. Outside on an open axis is the cell list's to refuse.
+#[test]
+fn positions_outside_a_periodic_box_are_refused() {
+    let dom = Domain3::new(Vec3::ZERO, Vec3::new(2.0, 3.0, 1.0), [true, true, false])
+        .unwrap()
+        .with_lees_edwards(0.5)
+        .unwrap();
+    let mut sys = SphereSystem::new(dom);
+    sys.add_sphere(Vec3::new(0.5, 1.0, 0.5), Vec3::ZERO, Vec3::ZERO, 0.04, 1.0)
+        .unwrap();
+    sys.add_sphere(Vec3::new(1.5, 2.0, 0.5), Vec3::ZERO, Vec3::ZERO, 0.04, 1.0)
+        .unwrap();
+    assert!(sys.validate().is_ok());
+    for (axis, name, v) in [(1, "y", 3.0), (0, "x", -1e-3)] {
+        let mut bad = sys.clone();
+        match axis {
+            0 => bad.spheres.pos[1].x = v,
+            _ => bad.spheres.pos[1].y = v,
+        }
+        let msg = bad.validate().unwrap_err().to_string();
+        println!("{msg}");
+        assert!(
+            msg.contains("spheres.pos")
+                && msg.contains(&format!("sphere 1 at {name} = {v:e} m"))
+                && msg.contains("wrap_moving"),
+            "{msg}"
+        );
+        let json = serde_json::to_string(&bad).unwrap();
+        let err = serde_json::from_str::<SphereSystem>(&json)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("sphere 1 at"), "{err}");
+        let law = LinearSpring::ness(1.0, 0.5, 0.5);
+        let before = bad.clone();
+        assert!(
+            SphereStepper::new()
+                .step(&SphereStepParams::new(1e-4, 0.005), &law, &mut bad)
+                .is_err()
+        );
+        assert_eq!(bad, before);
+    }
+    // Above the box on the open z axis: not this check's.
+    sys.spheres.pos[0].z = 1.5;
+    assert!(sys.validate().is_ok());
+}

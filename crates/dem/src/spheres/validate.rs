@@ -115,6 +115,7 @@ impl SphereSystem {
         ] {
             all_finite(field, v)?;
         }
+        self.inside_periodic("spheres.pos", "sphere", &s.pos)?;
         if let Some(k) = (0..n).find(|&k| {
             s.frozen[k] && (s.owner[k] != FREE || s.vel[k] != Vec3::ZERO || s.omega[k] != Vec3::ZERO)
         }) {
@@ -148,6 +149,29 @@ impl SphereSystem {
         }
         self.validate_contacts()?;
         self.validate_clumps()
+    }
+
+    /// Positions inside [lo, hi) on every periodic axis (the stepper wraps them there; the
+    /// minimum image assumes it, and the cell list would file them in the wrong cell).
+    fn inside_periodic(&self, field: &'static str, what: &str, pos: &[Vec3]) -> Result<(), SphereError> {
+        const AXES: [&str; 3] = ["x", "y", "z"];
+        let d = &self.domain;
+        for (k, p) in pos.iter().enumerate() {
+            for (a, axis) in AXES.iter().enumerate() {
+                let (lo, hi, v) = (d.lo.component(a), d.hi.component(a), p.component(a));
+                if d.periodic[a] && !(v >= lo && v < hi) {
+                    return Err(bad(
+                        field,
+                        format!(
+                            "{what} {k} at {axis} = {v:e} m, outside [{lo:e}, {hi:e}) on the periodic axis {axis}"
+                        ),
+                        "positions inside the box on periodic axes: wrap them with Domain3::wrap_moving \
+                         (position and velocity, for the Lees-Edwards shift), as add_sphere and add_clump do",
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     fn validate_contacts(&self) -> Result<(), SphereError> {
@@ -219,6 +243,7 @@ impl SphereSystem {
         ] {
             all_finite(field, v)?;
         }
+        self.inside_periodic("clumps.pos", "clump", &cl.pos)?;
         all_positive("clumps.mass", cl.mass.iter().copied())?;
         all_positive("clumps.inertia", cl.inertia.iter().flat_map(|i| [i.x, i.y, i.z]))?;
         for (k, q) in cl.quat.iter().enumerate() {
