@@ -136,7 +136,6 @@ impl CellList3 {
         // so a sphere whose y-neighbour layer lies across the face searches that layer's whole
         // x row (2 of every n_y layers do; the minimum image decides).
         let sheared = dom.shear.is_some();
-        let all_x: Vec<usize> = (0..nc[0]).collect();
         for i in 0..n {
             let c = self.cell[i] as usize;
             let (cx, cy, cz) = (c % nc[0], (c / nc[0]) % nc[1], c / (nc[0] * nc[1]));
@@ -147,12 +146,13 @@ impl CellList3 {
             let (pi, ri) = (pos[i], r[i]);
             for &z in &zs[..mz] {
                 for (&y, &y_across) in ys[..my].iter().zip(&y_across[..my]) {
-                    let row = if sheared && y_across {
-                        &all_x[..]
+                    // The whole row (a range, nothing allocated), or the x neighbours.
+                    let (row, nbs) = if sheared && y_across {
+                        (0..nc[0], &[][..])
                     } else {
-                        &xs[..mx]
+                        (0..0, &xs[..mx])
                     };
-                    for &x in row {
+                    for x in row.chain(nbs.iter().copied()) {
                         let cc = (z * nc[1] + y) * nc[0] + x;
                         let members = self.cell_start[cc] as usize..self.cell_start[cc + 1] as usize;
                         for &j in &self.sorted[members] {

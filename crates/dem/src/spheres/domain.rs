@@ -77,10 +77,16 @@ impl Domain3 {
             return Ok(());
         };
         if !(self.periodic[0] && self.periodic[1]) {
+            // The open axis named (x first if both are).
             return Err(SphereError::BadParameter {
-                name: "Lees-Edwards shear rate",
-                value: le.rate,
-                why: "Lees-Edwards boundaries need a box periodic in x (flow) and y (gradient)",
+                name: if self.periodic[0] {
+                    "periodic flag of the y axis (0 = open)"
+                } else {
+                    "periodic flag of the x axis (0 = open)"
+                },
+                value: 0.0,
+                why: "Lees-Edwards boundaries need a box periodic in x (flow) and y (gradient); make both \
+                      axes periodic",
             });
         }
         if !le.rate.is_finite() {
@@ -253,8 +259,9 @@ mod tests {
             "{far:?}"
         );
         assert!(Domain3::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0), [false; 3]).is_err());
-        // Lees-Edwards needs x and y periodic.
-        assert!(d.with_lees_edwards(1.0).is_err());
+        // Lees-Edwards needs x and y periodic: the error names the open axis.
+        let e = d.with_lees_edwards(1.0).unwrap_err().to_string();
+        assert!(e.starts_with("periodic flag of the y axis (0 = open) = 0"), "{e}");
         // One ulp below lo: lo - ulp + L rounds to hi, and the old `hi -> lo` fallback shifted
         // it to lo - ulp again, outside the box (found by a random search).
         let (lo, hi) = (0.7355621288699867, 3.6571500849874647);
