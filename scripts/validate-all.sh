@@ -32,8 +32,10 @@ lbdem-dem|shear_rheology|flow_curve_against_boyer_et_al|simple shear of 400 lubr
 '
 # Ignored tests that are explorations (they print, they assert nothing): not validations.
 # shellcheck disable=SC2034
-EXPLORATIONS='lbdem-lbm|stability|explore_tau
-lbdem-dem|shear_rheology|ci_case_against_smaller_step_and_stokes_number'
+EXPLORATIONS='
+lbdem-lbm|stability|explore_tau|
+lbdem-dem|shear_rheology|ci_case_against_smaller_step_and_stokes_number|
+'
 
 list_only=0
 filters=()
