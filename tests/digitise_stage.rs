@@ -5,30 +5,11 @@ use lbdem_grains::synth::{SynthSpec, generate};
 use std::path::Path;
 use std::process::Command;
 
-/// Column `name` of the CSV table at `path`, every cell a finite number. Read strictly: polars'
-/// default cast turns a cell that is not a number into null and `f64_column` turns that into NaN,
-/// which an assertion can then pass by accident (every comparison with NaN is false); here a
-/// malformed table fails the test, naming the file, column and row.
+/// Column `name` of the CSV table at `path`, every cell a finite number (a malformed table
+/// fails the test, naming the file, column and row: `table::finite_f64_column`).
 fn finite_column(path: &Path, name: &str) -> Vec<f64> {
     let df = lbdem::report::table::read_table(path).unwrap();
-    let c = df
-        .column(name)
-        .unwrap_or_else(|_| panic!("{} has no column '{name}'", path.display()))
-        .strict_cast(&polars::prelude::DataType::Float64)
-        .unwrap_or_else(|e| panic!("{}: column '{name}' is not all numbers: {e}", path.display()));
-    c.f64()
-        .unwrap()
-        .iter()
-        .enumerate()
-        .map(|(k, v)| match v {
-            Some(x) if x.is_finite() => x,
-            _ => panic!(
-                "{}: column '{name}', data row {}: {v:?}, not a finite number",
-                path.display(),
-                k + 1
-            ),
-        })
-        .collect()
+    lbdem::report::table::finite_f64_column(&df, name, path).unwrap()
 }
 
 fn save_png(path: &Path, img: &ndarray::Array2<f64>) {

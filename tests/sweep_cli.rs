@@ -34,30 +34,11 @@ fn column(csv: &Path, name: &str) -> Vec<String> {
         .collect()
 }
 
-/// Column `name` of the CSV table at `csv`, every cell a finite number. Read strictly: polars'
-/// default cast turns a cell that is not a number into null and `f64_column` turns that into NaN,
-/// which an assertion can then pass by accident (every comparison with NaN is false); here a
-/// malformed table fails the test, naming the file, column and row.
+/// Column `name` of the CSV table at `csv`, every cell a finite number (a malformed table
+/// fails the test, naming the file, column and row: `table::finite_f64_column`).
 fn numbers(csv: &Path, name: &str) -> Vec<f64> {
     let df = table::read_table(csv).unwrap();
-    let c = df
-        .column(name)
-        .unwrap_or_else(|_| panic!("{} has no column '{name}'", csv.display()))
-        .strict_cast(&DataType::Float64)
-        .unwrap_or_else(|e| panic!("{}: column '{name}' is not all numbers: {e}", csv.display()));
-    c.f64()
-        .unwrap()
-        .iter()
-        .enumerate()
-        .map(|(k, v)| match v {
-            Some(x) if x.is_finite() => x,
-            _ => panic!(
-                "{}: column '{name}', data row {}: {v:?}, not a finite number",
-                csv.display(),
-                k + 1
-            ),
-        })
-        .collect()
+    table::finite_f64_column(&df, name, csv).unwrap()
 }
 
 /// The readers above fail on a malformed table (a word, an empty cell or NaN where a number

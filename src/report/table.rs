@@ -93,6 +93,34 @@ pub fn f64_column(df: &DataFrame, name: &str, path: &Path) -> Result<Vec<f64>> {
     Ok(c.f64()?.iter().map(|v| v.unwrap_or(f64::NAN)).collect())
 }
 
+/// Column `name` of `df` as f64, every cell a finite number: a cell that is not a number, an
+/// empty cell or a NaN is an error naming the file, the column and the data row (where
+/// [`f64_column`] would give NaN, which a comparison can then pass by accident).
+pub fn finite_f64_column(df: &DataFrame, name: &str, path: &Path) -> Result<Vec<f64>> {
+    let c = df
+        .column(name)
+        .map_err(|_| anyhow::anyhow!("table {} has no column '{name}'", path.display()))?
+        .strict_cast(&DataType::Float64)
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "table {}: column '{name}' is not all numbers: {e}",
+                path.display()
+            )
+        })?;
+    c.f64()?
+        .iter()
+        .enumerate()
+        .map(|(k, v)| match v {
+            Some(x) if x.is_finite() => Ok(x),
+            _ => bail!(
+                "table {}: column '{name}', data row {}: {v:?}, not a finite number",
+                path.display(),
+                k + 1
+            ),
+        })
+        .collect()
+}
+
 /// Column `name` of `df` as text (numbers are printed; empty cells become "").
 pub fn str_column(df: &DataFrame, name: &str, path: &Path) -> Result<Vec<String>> {
     let c = df
