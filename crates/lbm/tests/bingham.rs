@@ -12,8 +12,7 @@
 mod common;
 use common::*;
 use lbdem_lbm::{
-    Bingham, Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, LbmError, Macro, Motion, Real, Stepper,
-    StepperAa,
+    Bingham, Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, LbmError, Macro, Real, Stepper, StepperAa,
 };
 
 /// One Bingham channel case: `h_nodes` fluid rows between halfway bounce-back walls (half-width
@@ -304,42 +303,6 @@ fn bingham_poiseuille_d3q19() {
     assert_eq!(e.core_rows, e.core_rows_exact, "{e:?}");
 }
 
-/// A lattice with every kind of node (moving lid, a moving and spinning obstacle, periodic x
-/// edges) and a non-uniform start, as in `local_tau.rs`.
-fn busy<L: Lattice, T: Real>(n: [usize; 3]) -> Fluid<L, T> {
-    let lid = Face::Wall {
-        velocity: [0.02, 0.0, 0.0],
-    };
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let mut dom = Domain::new(
-        n,
-        [
-            Face::Periodic,
-            Face::Periodic,
-            wall,
-            lid,
-            Face::Periodic,
-            Face::Periodic,
-        ],
-    );
-    let c = [
-        n[0] as f64 / 3.0,
-        n[1] as f64 / 2.0,
-        if n[2] > 1 { n[2] as f64 / 2.0 } else { 0.0 },
-    ];
-    dom.fill_sphere(0, c, n[1] as f64 / 5.0);
-    let mut fl = Fluid::<L, T>::new(
-        dom,
-        vec![Motion {
-            centre: c,
-            velocity: [0.0, 0.005, 0.0],
-            omega: [0.0, 0.0, 2e-3],
-        }],
-    );
-    fl.init_equilibrium(|p| (1.0 + 1e-3 * ((p[0] * 3 + p[1]) % 5) as f64, [0.01, 0.0, 0.0]));
-    fl
-}
-
 fn bits<T: Real>(f: &[T]) -> Vec<u64> {
     f.iter().map(|v| v.to_f64().to_bits()).collect()
 }
@@ -360,7 +323,7 @@ fn busy_bingham() -> Bingham {
 /// the run is not the Newtonian one (the rheology acts).
 fn kernels_agree<L: Lattice, T: Real>(n: [usize; 3], collision: Collision) {
     let s = settings(collision, [1e-5, 0.0, 0.0]);
-    let mut a = busy::<L, T>(n);
+    let mut a = busy_fluid::<L, T>(n);
     let mut b = a.clone();
     let mut newt = a.clone();
     let mut two = Stepper::new(&a, s).unwrap();
@@ -412,7 +375,7 @@ fn zero_yield_stress_is_the_newtonian_run_bitwise() {
             ..busy_bingham()
         };
         let s = settings(Collision::Bgk { tau: b.tau_pl() }, [1e-5, 0.0, 0.0]);
-        let mut a = busy::<L, f64>(n);
+        let mut a = busy_fluid::<L, f64>(n);
         let mut c = a.clone();
         let mut d = a.clone();
         let mut e = a.clone();
@@ -453,7 +416,7 @@ fn bingham_identical_for_one_and_two_threads() {
             .build()
             .unwrap();
         pool.install(|| {
-            let mut fl = busy::<D2Q9, f64>([40, 48, 1]);
+            let mut fl = busy_fluid::<D2Q9, f64>([40, 48, 1]);
             let mut st = StepperAa::new(&mut fl, s).unwrap();
             st.partition = partition;
             st.set_bingham(Some(busy_bingham())).unwrap();
@@ -482,14 +445,14 @@ fn bingham_run_resumes_bit_for_bit() {
         [1e-5, 0.0, 0.0],
     );
     let (steps, k) = (24, 10);
-    let mut a = busy::<D3Q19, f64>([16, 12, 10]);
+    let mut a = busy_fluid::<D3Q19, f64>([16, 12, 10]);
     let mut st = StepperAa::new(&mut a, s).unwrap();
     st.set_bingham(Some(busy_bingham())).unwrap();
     for _ in 0..steps {
         st.step(&mut a, None).unwrap();
     }
     st.finish(&mut a).unwrap();
-    let mut b = busy::<D3Q19, f64>([16, 12, 10]);
+    let mut b = busy_fluid::<D3Q19, f64>([16, 12, 10]);
     let mut st = StepperAa::new(&mut b, s).unwrap();
     st.set_bingham(Some(busy_bingham())).unwrap();
     for _ in 0..k {
@@ -544,7 +507,7 @@ fn bingham_parameters_are_checked() {
         assert!(msg.contains(name) && msg.contains(fix), "{msg}");
     }
     // the steppers refuse them too, and a TRT magic parameter <= 0
-    let fl = busy::<D2Q9, f64>([8, 8, 1]);
+    let fl = busy_fluid::<D2Q9, f64>([8, 8, 1]);
     let mut st = Stepper::new(&fl, settings(Collision::Bgk { tau: 0.8 }, [0.0; 3])).unwrap();
     assert!(st.set_bingham(Some(Bingham { tau_min: 0.4, ..ok })).is_err());
     assert!(st.bingham().is_none());

@@ -7,42 +7,8 @@
 mod common;
 use common::*;
 use lbdem_lbm::{
-    Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, LbmError, Macro, Motion, Real, Stepper, StepperAa,
+    Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, LbmError, Macro, Real, Stepper, StepperAa,
 };
-
-fn setup<L: Lattice, T: Real>(n: [usize; 3]) -> Fluid<L, T> {
-    let lid = Face::Wall {
-        velocity: [0.02, 0.0, 0.0],
-    };
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let mut dom = Domain::new(
-        n,
-        [
-            Face::Periodic,
-            Face::Periodic,
-            wall,
-            lid,
-            Face::Periodic,
-            Face::Periodic,
-        ],
-    );
-    let c = [
-        n[0] as f64 / 3.0,
-        n[1] as f64 / 2.0,
-        if n[2] > 1 { n[2] as f64 / 2.0 } else { 0.0 },
-    ];
-    dom.fill_sphere(0, c, n[1] as f64 / 5.0);
-    let mut fl = Fluid::<L, T>::new(
-        dom,
-        vec![Motion {
-            centre: c,
-            velocity: [0.0, 0.005, 0.0],
-            omega: [0.0, 0.0, 2e-3],
-        }],
-    );
-    fl.init_equilibrium(|p| (1.0 + 1e-3 * ((p[0] * 3 + p[1]) % 5) as f64, [0.01, 0.0, 0.0]));
-    fl
-}
 
 fn bits<T: Real>(f: &[T]) -> Vec<u64> {
     f.iter().map(|v| v.to_f64().to_bits()).collect()
@@ -54,7 +20,7 @@ fn equal_rates_are_uniform<L: Lattice, T: Real>(n: [usize; 3], collision: Collis
     let nodes = n[0] * n[1] * n[2];
     let tau = vec![collision.tau(); nodes];
     // two-array
-    let mut a = setup::<L, T>(n);
+    let mut a = busy_fluid::<L, T>(n);
     let mut b = a.clone();
     let mut uni = Stepper::new(&a, s).unwrap();
     let mut loc = Stepper::new(&b, s).unwrap();
@@ -100,7 +66,7 @@ fn equal_local_rates_reproduce_the_uniform_run_bitwise() {
 
 #[test]
 fn local_tau_is_checked() {
-    let fl = setup::<D2Q9, f64>([8, 8, 1]);
+    let fl = busy_fluid::<D2Q9, f64>([8, 8, 1]);
     let mut st = Stepper::new(&fl, settings(Collision::Bgk { tau: 0.8 }, [0.0; 3])).unwrap();
     let mut tau = vec![0.8; 64];
     tau[13] = 0.5;
@@ -229,13 +195,13 @@ fn resume<L: Lattice>(n: [usize; 3]) {
     );
     let (steps, k) = (24, 10);
     // AA
-    let mut a = setup::<L, f64>(n);
+    let mut a = busy_fluid::<L, f64>(n);
     let mut st = StepperAa::new(&mut a, s).unwrap();
     for _ in 0..steps {
         st.step(&mut a, None).unwrap();
     }
     st.finish(&mut a).unwrap();
-    let mut b = setup::<L, f64>(n);
+    let mut b = busy_fluid::<L, f64>(n);
     let mut st = StepperAa::new(&mut b, s).unwrap();
     for _ in 0..k {
         st.step(&mut b, None).unwrap();
@@ -255,13 +221,13 @@ fn resume<L: Lattice>(n: [usize; 3]) {
     st.finish(&mut c).unwrap();
     assert!(bits(&a.f) == bits(&c.f), "AA resume {}", L::NAME);
     // two-array: the fluid is the whole state
-    let mut a = setup::<L, f64>(n);
+    let mut a = busy_fluid::<L, f64>(n);
     let mut st = Stepper::new(&a, s).unwrap();
     let mut m = Macro::default();
     for _ in 0..steps {
         st.step(&mut a, Some(&mut m)).unwrap();
     }
-    let mut b = setup::<L, f64>(n);
+    let mut b = busy_fluid::<L, f64>(n);
     let mut st = Stepper::new(&b, s).unwrap();
     for _ in 0..k {
         st.step(&mut b, None).unwrap();

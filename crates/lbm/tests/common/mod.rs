@@ -1,7 +1,7 @@
 //! Shared helpers of the validation tests.
 #![allow(dead_code)]
 
-use lbdem_lbm::{Collision, Fluid, Lattice, Limits, Macro, Motion, Real, Settings, Stepper};
+use lbdem_lbm::{Collision, Domain, Face, Fluid, Lattice, Limits, Macro, Motion, Real, Settings, Stepper};
 
 pub fn settings(collision: Collision, force: [f64; 3]) -> Settings {
     Settings {
@@ -49,4 +49,40 @@ pub use lbdem_lbm::cases::poiseuille::channel;
 
 pub fn no_obstacles() -> Vec<Motion> {
     Vec::new()
+}
+
+/// A lattice with every kind of node (moving lid, a moving and spinning obstacle, periodic x
+/// edges) and a non-uniform start: the fixture of the local-τ and Bingham kernel comparisons.
+pub fn busy_fluid<L: Lattice, T: Real>(n: [usize; 3]) -> Fluid<L, T> {
+    let lid = Face::Wall {
+        velocity: [0.02, 0.0, 0.0],
+    };
+    let wall = Face::Wall { velocity: [0.0; 3] };
+    let mut dom = Domain::new(
+        n,
+        [
+            Face::Periodic,
+            Face::Periodic,
+            wall,
+            lid,
+            Face::Periodic,
+            Face::Periodic,
+        ],
+    );
+    let c = [
+        n[0] as f64 / 3.0,
+        n[1] as f64 / 2.0,
+        if n[2] > 1 { n[2] as f64 / 2.0 } else { 0.0 },
+    ];
+    dom.fill_sphere(0, c, n[1] as f64 / 5.0);
+    let mut fl = Fluid::<L, T>::new(
+        dom,
+        vec![Motion {
+            centre: c,
+            velocity: [0.0, 0.005, 0.0],
+            omega: [0.0, 0.0, 2e-3],
+        }],
+    );
+    fl.init_equilibrium(|p| (1.0 + 1e-3 * ((p[0] * 3 + p[1]) % 5) as f64, [0.01, 0.0, 0.0]));
+    fl
 }
