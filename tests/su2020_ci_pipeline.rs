@@ -100,8 +100,19 @@ fn su2020_ci_pipeline_analyses_compares_maps_and_reports() {
     assert_eq!(wet["class"], "cracking");
     // Eq. 21 is evaluated at the run's inertial number.
     assert!(wet["dynamic_dilatancy"]["critical_packing"].as_f64().unwrap() < 0.81);
-    // The float run draws Fig. 5h.
+    // The float run draws Fig. 5h, and finds the packed zone as Su did on the radiographs
+    // (grains that moved under 2 µm, here in 0.3 s): none while the grains rise, a packed top
+    // layer at the end. Measured: NaN for the first six pairs, 0.810 over one band at 1.5 s.
     assert!(out.join("analyse-float/packed_zone.png").is_file());
+    let p = out.join("analyse-float/packed_zone_displacement.csv");
+    let df = lbdem::report::table::read_table(&p).unwrap();
+    let frac = lbdem::report::table::f64_column(&df, "packed_zone_fraction", &p).unwrap();
+    assert!(frac.len() >= 8, "{frac:?}");
+    assert!(frac[0].is_nan(), "{frac:?}");
+    let last = frac[frac.len() - 1];
+    assert!(last > 0.70 && last < 0.85, "{frac:?}");
+    let float = json(&out.join("analyse-float/analysis.json"));
+    assert_eq!(float["packed_zone"]["pairs"].as_u64(), Some(frac.len() as u64));
 
     // The run rendered as radiographs and put through the radiograph stage: XIP beside TRI on the
     // same snapshots. Measured at u_y = 0.95 d (since the resting solid zone, 2026-11-25): XIP

@@ -65,14 +65,33 @@ impl PackedZone {
         })
     }
 
-    /// One series row ([`COLUMNS`]).
+    /// One series row ([`COLUMNS`]): a grain is still when its speed is below `slower_than`.
     pub fn sample(&self, sys: &System) -> Vec<f64> {
         let b = &sys.bodies;
+        let grains = (0..b.len()).map(|k| {
+            let speed = b.vel[k].x.hypot(b.vel[k].y);
+            let circles =
+                (b.circle_start[k]..b.circle_start[k + 1]).map(move |c| (b.circle_pos(c).y, b.circle_r[c]));
+            (b.mass[k] / b.density[k], speed < self.slower_than, circles)
+        });
+        self.measure(grains).to_vec()
+    }
+
+    /// The zone of grains given as (own area, still, circles (y, r)): Su's radiographs call a
+    /// grain still when it moved under 2 µm in 10 s (Sect. 3.2); a run's series uses the
+    /// instantaneous speed ([`Self::sample`]), the analysis of its snapshots the displacement.
+    /// Returns [`COLUMNS`]: the zone's packing fraction (NaN when no band is packed), its
+    /// height and the grains' area over the box.
+    pub fn measure<I, C>(&self, grains: I) -> [f64; 3]
+    where
+        I: Iterator<Item = (f64, bool, C)>,
+        C: Iterator<Item = (f64, f64)> + Clone,
+    {
         let height = self.hi[1] - self.lo[1];
         let width = self.hi[0] - self.lo[0];
         let n = (height / self.band).ceil() as usize;
         let mut area = vec![0.0; n];
-        let mut fastest = vec![0.0f64; n];
+        let mut moving = vec![false; n];
         // Band k counts from the packing side.
         let band_of = |y: f64| {
             let from = if self.top { self.hi[1] - y } else { y - self.lo[1] };
@@ -87,34 +106,30 @@ impl PackedZone {
             }
         };
         let mut total = 0.0;
-        for k in 0..b.len() {
+        for (own, still, circles) in grains {
             // The circles of a clump overlap: scale their areas to the body's own.
-            let circles = b.circle_start[k]..b.circle_start[k + 1];
             let sum: f64 = circles
                 .clone()
-                .map(|c| std::f64::consts::PI * b.circle_r[c].powi(2))
+                .map(|(_, r)| std::f64::consts::PI * r.powi(2))
                 .sum();
-            let own = b.mass[k] / b.density[k];
             let scale = own / sum.max(f64::MIN_POSITIVE);
             total += own;
-            let speed = b.vel[k].x.hypot(b.vel[k].y);
-            for c in circles {
-                let (p, r) = (b.circle_pos(c), b.circle_r[c]);
-                let (k0, k1) = (band_of(p.y + r), band_of(p.y - r));
+            for (y, r) in circles {
+                let (k0, k1) = (band_of(y + r), band_of(y - r));
                 for kb in k0.min(k1)..=k0.max(k1) {
                     let (y0, y1) = bounds(kb);
-                    let a = disc_between(p.y, r, y0, y1) * scale;
+                    let a = disc_between(y, r, y0, y1) * scale;
                     if a > 0.0 {
                         area[kb] += a;
-                        fastest[kb] = fastest[kb].max(speed);
+                        moving[kb] |= !still;
                     }
                 }
             }
         }
         let mut zone = (0.0, 0.0);
         for kb in 0..n {
-            // A band is part of the zone if it holds grains and all of them are slow.
-            if area[kb] <= 0.0 || fastest[kb] >= self.slower_than {
+            // A band is part of the zone if it holds grains and all of them are still.
+            if area[kb] <= 0.0 || moving[kb] {
                 break;
             }
             let (y0, y1) = bounds(kb);
@@ -126,7 +141,7 @@ impl PackedZone {
         } else {
             f64::NAN
         };
-        vec![fraction, zone.1, total / (width * height)]
+        [fraction, zone.1, total / (width * height)]
     }
 }
 

@@ -261,48 +261,5 @@ pub(super) fn series_figures(
         });
         files.push(f.into());
     }
-    // Fig. 5h: the packed zone's packing fraction over time.
-    if let (Some(pz), Some(fov)) = (run.series("packed_zone_fraction"), run.series("packing_box")) {
-        let t = run.series("time").unwrap_or_default();
-        let f = "packed_zone.png";
-        lines_png(
-            &out.join(f),
-            &[
-                Line {
-                    label: "f_S,pk,PK (packed zone)",
-                    x: &t,
-                    y: &pz,
-                    style: Style::Solid,
-                    colour: Some((30, 90, 200)),
-                },
-                Line {
-                    label: "f_S,pk,FOV (box)",
-                    x: &t,
-                    y: &fov,
-                    style: Style::Dashed,
-                    colour: Some((200, 60, 30)),
-                },
-            ],
-            &LinesPlot {
-                title: "packing fraction of the floated layer (Su Fig. 5h)",
-                x_label: "t_DEM (s)",
-                y_label: "packing fraction (-)",
-                h_refs: vec![Reference {
-                    value: 0.77,
-                    label: "Su: ≈ 77 %",
-                }],
-                ..Default::default()
-            },
-        )?;
-        figures.push(Figure {
-            path: f.into(),
-            caption: format!(
-                "Packing fraction of the packed zone (grains slower than the run's threshold, from the side they \
-                 pack against) and of the whole box over time, as Su et al. 2020 Fig. 5h; their full Float case \
-                 reached ≈ 77 %. From {src}."
-            ),
-        });
-        files.push(f.into());
-    }
     Ok(())
 }

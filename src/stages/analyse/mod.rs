@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 
 mod figures;
 mod frames;
+mod packed;
 
 use figures::{draw_maps, series_figures};
 use frames::median;
@@ -91,6 +92,12 @@ pub struct Params {
     /// Draw maps for at most this many snapshots (the last ones); tables cover all.
     #[serde(default = "three")]
     pub max_maps: usize,
+    /// A Float run's packed zone by displacement: grains that moved less than
+    /// `packed_moved_less_than` (m) in `packed_window` (s) are still (Su Sect. 3.2: 2 µm in 10 s).
+    #[serde(default = "ten")]
+    pub packed_window: f64,
+    #[serde(default = "two_um")]
+    pub packed_moved_less_than: f64,
 }
 
 #[derive(Clone, Copy, Debug, Serialize, Deserialize)]
@@ -115,6 +122,12 @@ fn one() -> f64 {
 }
 fn touch_gap() -> f64 {
     0.05
+}
+fn ten() -> f64 {
+    10.0
+}
+fn two_um() -> f64 {
+    2.0e-6
 }
 fn three() -> usize {
     3
@@ -402,6 +415,7 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
         _ => None,
     };
     series_figures(p, run, &rows, crossing, d_bar, out, &mut figures, &mut files)?;
+    let packed_zone = packed::analyse(p, run, out, &mut figures, &mut files, &mut tables)?;
 
     let rate = run.plate.map(|pl| pl.velocity[0].hypot(pl.velocity[1]));
     let last = last_fields.as_ref();
@@ -413,6 +427,7 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
         "d_bar_m": d_bar,
         "reference": match ref_step { Some(s) => format!("snapshot at step {s}"), None => "the scene's particle file (step 0)".into() },
         "snapshots": steps.len(),
+        "packed_zone": packed_zone,
         "triangles": setup.mesh.len(),
         "rev_side_px": setup.rev_side,
         "pixel_d": setup.grid.dx,
