@@ -99,41 +99,96 @@ pub fn cell_fraction(c: [f64; 2], r: f64, i: i64, j: i64) -> f64 {
     disk_rect_area(c, r, x, x + 1.0, y, y + 1.0).min(1.0)
 }
 
-/// Angles of a circle as a union of intervals in [0, 2π).
+/// A point of a circle, c + r (cos θ, sin θ), held by its unit vector and a pseudo-angle in
+/// [0, 4] that grows with θ (one per quadrant, no transcendental call): the arcs are cut and
+/// ordered by the pseudo-angle, and their area terms need cos and sin at the ends, which the
+/// point gives exactly. Only the final arcs' spans take an arctangent.
+#[derive(Clone, Copy)]
+struct End {
+    p: f64,
+    cos: f64,
+    sin: f64,
+}
+
+impl End {
+    /// θ = 0 (p = 0) and θ = 2π (p = 4).
+    const START: End = End {
+        p: 0.0,
+        cos: 1.0,
+        sin: 0.0,
+    };
+    const FULL: End = End {
+        p: 4.0,
+        cos: 1.0,
+        sin: 0.0,
+    };
+
+    /// The point at offset (dx, dy) from the centre of a circle of radius r.
+    fn at(dx: f64, dy: f64, r: f64) -> End {
+        let (cos, sin) = (dx / r, dy / r);
+        let p = if dy >= 0.0 {
+            if dx >= 0.0 {
+                dy / (dx + dy).max(f64::MIN_POSITIVE)
+            } else {
+                1.0 - dx / (dy - dx)
+            }
+        } else if dx < 0.0 {
+            2.0 - dy / (-dx - dy)
+        } else {
+            3.0 + dx / (dx - dy)
+        };
+        End { p, cos, sin }
+    }
+
+    /// θ in [0, 2π], placed on the side of the wrap its pseudo-angle says (an arctangent of a
+    /// point a rounding off the positive x axis may land on the other side).
+    fn theta(&self) -> f64 {
+        let t = self.sin.atan2(self.cos);
+        if self.p < 2.0 {
+            if t < -FRAC_PI_2 { t + TAU } else { t.max(0.0) }
+        } else if t < FRAC_PI_2 {
+            t + TAU
+        } else {
+            t
+        }
+    }
+}
+
+/// A circle's points as a union of arcs, each counter-clockwise from its first end to its
+/// second, pseudo-angles within [0, 4].
 #[derive(Clone, Copy)]
 struct Arcs {
-    iv: [(f64, f64); 4],
+    iv: [(End, End); 4],
     n: usize,
 }
 
 const TAU: f64 = std::f64::consts::TAU;
+const FRAC_PI_2: f64 = std::f64::consts::FRAC_PI_2;
 
 impl Arcs {
     const ALL: Arcs = Arcs {
-        iv: [(0.0, TAU); 4],
+        iv: [(End::START, End::FULL); 4],
         n: 1,
     };
     const NONE: Arcs = Arcs {
-        iv: [(0.0, 0.0); 4],
+        iv: [(End::START, End::START); 4],
         n: 0,
     };
 
-    /// [lo, hi] (hi − lo ≤ 2π) folded into [0, 2π).
-    fn span(lo: f64, hi: f64) -> Arcs {
-        let lo_m = lo.rem_euclid(TAU);
-        let hi_m = lo_m + (hi - lo);
+    /// Counter-clockwise from `from` to `to`; the whole circle when they are the same point.
+    fn span(from: End, to: End) -> Arcs {
         let mut a = Arcs::NONE;
-        if hi_m <= TAU {
-            a.push(lo_m, hi_m);
+        if to.p > from.p {
+            a.push(from, to);
         } else {
-            a.push(lo_m, TAU);
-            a.push(0.0, hi_m - TAU);
+            a.push(from, End::FULL);
+            a.push(End::START, to);
         }
         a
     }
 
-    fn push(&mut self, a: f64, b: f64) {
-        if b > a && self.n < 4 {
+    fn push(&mut self, a: End, b: End) {
+        if b.p > a.p && self.n < 4 {
             self.iv[self.n] = (a, b);
             self.n += 1;
         }
@@ -143,7 +198,9 @@ impl Arcs {
         let mut out = Arcs::NONE;
         for &(a, b) in &self.iv[..self.n] {
             for &(c, d) in &o.iv[..o.n] {
-                out.push(a.max(c), b.min(d));
+                let lo = if c.p > a.p { c } else { a };
+                let hi = if d.p < b.p { d } else { b };
+                out.push(lo, hi);
             }
         }
         out
@@ -230,7 +287,7 @@ pub fn rect_lens_area(a: ([f64; 2], f64), b: ([f64; 2], f64), x0: f64, x1: f64, 
     for k in 0..2 {
         let (c, r) = disks[k];
         let or = disks[1 - k].1;
-        let ang = |p: [f64; 2]| (p[1] - c[1]).atan2(p[0] - c[0]);
+        let ang = |p: [f64; 2]| End::at(p[0] - c[0], p[1] - c[1], r);
         let mut set = Arcs::ALL;
         // x >= 0, x <= w, y >= 0, y <= h: each keeps the arc between its chord's ends.
         for (axis, at, keep_above) in [(0, 0.0, true), (0, w, false), (1, 0.0, true), (1, h, false)] {
@@ -253,7 +310,6 @@ pub fn rect_lens_area(a: ([f64; 2], f64), b: ([f64; 2], f64), x0: f64, x1: f64, 
                         (true, true) | (false, false) => (e1, e2),
                         (true, false) | (false, true) => (e2, e1),
                     };
-                    let to = if to <= from { to + TAU } else { to };
                     Arcs::span(from, to)
                 }
             };
@@ -267,7 +323,6 @@ pub fn rect_lens_area(a: ([f64; 2], f64), b: ([f64; 2], f64), x0: f64, x1: f64, 
                 } else {
                     (ang(p2), ang(p1))
                 };
-                let to = if to <= from { to + TAU } else { to };
                 Arcs::span(from, to)
             }
             None => {
@@ -277,9 +332,9 @@ pub fn rect_lens_area(a: ([f64; 2], f64), b: ([f64; 2], f64), x0: f64, x1: f64, 
             }
         };
         set = set.and(&inside_other);
-        for &(t0, t1) in &set.iv[..set.n] {
-            area += 0.5
-                * (r * r * (t1 - t0) + r * c[0] * (t1.sin() - t0.sin()) - r * c[1] * (t1.cos() - t0.cos()));
+        for &(e0, e1) in &set.iv[..set.n] {
+            let span = e1.theta() - e0.theta();
+            area += 0.5 * (r * r * span + r * c[0] * (e1.sin - e0.sin) - r * c[1] * (e1.cos - e0.cos));
         }
     }
     area.clamp(0.0, w * h)
