@@ -127,6 +127,21 @@ pub fn dispatch<Op: WithSimd>(op: Op) -> Op::Output {
     arch().dispatch(op)
 }
 
+/// Inside an op run by [`dispatch`]: whether this copy (`S`) runs with AVX-512 (the v4 copy,
+/// or any copy of a build for an AVX-512 CPU), so it may take hand-written AVX-512 code. A
+/// constant in each copy: the other branch is not compiled into it.
+#[inline(always)]
+pub fn is_v4<S: Simd>() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        NATIVE_V4 || std::any::TypeId::of::<S>() == std::any::TypeId::of::<pulp::x86::V4>()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// The whole build targets AVX-512 (x86-64-v4) already.
 pub const NATIVE_V4: bool = cfg!(all(
     target_arch = "x86_64",
