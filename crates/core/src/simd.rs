@@ -12,10 +12,12 @@
 //! A native build compiles every function for its CPU already: there the cap changes nothing,
 //! and the command line says so.
 //!
-//! STATUS (issue 17 item 8, open): the repository's `.cargo/config.toml` still builds for the
-//! native CPU, because the portable build is slower here (docs/performance.md, "Portable
-//! binaries"): 0.79-1.05x on the LBM benches, 0.41x on the DEM bench, where the lane kernels'
-//! closures and the rest of the DEM stepper run at the baseline level. A native build compiles every level alike ([`NATIVE_V4`]).
+//! A pass with hand-written AVX-512 code (the DEM lane kernels) asks [`is_v4`] inside its op,
+//! a constant in each compiled copy, and takes that code only in the v4 copy.
+//!
+//! The default build (`.cargo/config.toml`, no `target-cpu`) is this portable one: within a few
+//! per cent of a native build on the LBM and DEM benches (docs/performance.md, "Portable
+//! binaries"). A native build compiles every level alike ([`NATIVE_V4`]).
 
 use std::sync::OnceLock;
 
@@ -180,6 +182,23 @@ mod tests {
             Level::of(best)
         );
         assert_eq!(scalar.to_bits(), capped(Level::V3).dispatch(Sum(&v)).to_bits());
+    }
+
+    struct V4Here;
+    impl WithSimd for V4Here {
+        type Output = bool;
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, _: S) -> bool {
+            is_v4::<S>()
+        }
+    }
+
+    /// `is_v4` is true in exactly the copy that runs with AVX-512.
+    #[test]
+    fn is_v4_names_the_avx512_copy() {
+        assert_eq!(dispatch(V4Here), level() == Level::V4);
+        assert_eq!(Arch::Scalar.dispatch(V4Here), NATIVE_V4);
+        assert_eq!(capped(Level::V3).dispatch(V4Here), NATIVE_V4);
     }
 
     #[test]
