@@ -6,8 +6,8 @@
 //! Every function here is `#[inline(always)]` without `#[target_feature]`: it is compiled only
 //! into callers that enable AVX-512 F and DQ, the lane kernels' AVX-512 copy
 //! (`crate::on_avx512`), taken only in the v4 copy of a pass dispatched by `lbdem_core::simd`
-//! (`crate::lanes::avx512_in`), or a whole `target-cpu=native` build for such a CPU. Data movement and the scalar IEEE
-//! operations per lane: the bits are those of `super::portable`.
+//! (`crate::lanes::avx512_in`), or a whole `target-cpu=native` build for such a CPU. Data
+//! movement and the scalar IEEE operations per lane: the bits are those of `super::portable`.
 
 use super::W;
 use crate::contact::History;
@@ -141,8 +141,8 @@ pub(crate) fn interleave(x: F8, y: F8, p: &mut [[f64; 2]; W]) {
 pub(crate) fn transpose(r: [F8; W]) -> [[f64; W]; W] {
     let t = transpose_registers(r);
     let mut rows = [[0.0; W]; W];
-    for k in 0..W {
-        rows[k] = t[k].to_array();
+    for (row, v) in rows.iter_mut().zip(t) {
+        *row = v.to_array();
     }
     rows
 }
@@ -222,8 +222,8 @@ pub(crate) fn transpose8(cst: &[CircleState], idx: &[usize; W]) -> [F8; 8] {
     // (asserted by the caller); CircleState is repr(C), 64 bytes, 64-byte aligned, eight f64.
     unsafe {
         let mut r = [F8(_mm512_setzero_pd()); W];
-        for k in 0..W {
-            r[k] = F8(_mm512_load_pd(p.add(idx[k]).cast::<f64>()));
+        for (v, &i) in r.iter_mut().zip(idx) {
+            *v = F8(_mm512_load_pd(p.add(i).cast::<f64>()));
         }
         transpose_registers(r)
     }

@@ -170,8 +170,7 @@ impl WithSimd for KickChunk<'_> {
             let lanes = l0..l0 + W;
             let mut hm = [0.0; W];
             let mut hi = [0.0; W];
-            for k in 0..W {
-                let kk = &mut kc[l0 + k];
+            for (k, kk) in kc[lanes.clone()].iter_mut().enumerate() {
                 kk.refresh(h, m[l0 + k], i[l0 + k]);
                 hm[k] = kk.hm;
                 hi[k] = kk.hi;
