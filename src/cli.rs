@@ -165,7 +165,7 @@ pub fn main() -> Result<()> {
     {
         eprintln!(
             "warning: {} = {} has no effect: this binary was built for the native CPU (x86-64-v4), every \
-             function runs at that level; build a portable binary (RUSTFLAGS=\"-C target-cpu=x86-64\") to use the cap",
+             function runs at that level; build without `-C target-cpu=native` (the default, portable build) to use the cap",
             lbdem_core::simd::ISA_ENV,
             cap.name()
         );

@@ -1,6 +1,9 @@
 //! `LBDEM_ISA` (crates/core/src/simd.rs): a value naming no level is refused before anything
-//! runs, with the variable, the value and the accepted values; a valid cap is taken and printed (a native build warns that it has no effect).
+//! runs, with the variable, the value and the accepted values; a valid cap is taken and printed
+//! (a native build warns that it has no effect); and every level gives the same bits on a DEM
+//! scene and a coupled scene.
 
+use std::path::Path;
 use std::process::Command;
 
 fn lbdem(isa: &str, args: &[&str]) -> std::process::Output {
@@ -78,4 +81,168 @@ fn the_portable_cap_is_taken_or_its_lack_of_effect_named() {
         "SIMD portable"
     };
     assert!(err.contains(expect), "expected {expect:?} in: {err}");
+}
+
+/// Run `scene` (a scene file's text) once per `LBDEM_ISA` cap, `portable`, `v3` and none (the
+/// best level this CPU has), and compare `files` of the runs byte for byte. Snapshot and series
+/// files print every f64 in its shortest round-trip form, so equal bytes are equal bits.
+/// Returns the level each run printed.
+fn same_bits_at_every_level(scene: &str, extra: &[(&str, &str)], files: &[&str]) -> Vec<String> {
+    let t = tempfile::tempdir().unwrap();
+    let path = t.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    for (name, text) in extra {
+        std::fs::write(t.path().join(name), text).unwrap();
+    }
+    let mut runs = Vec::new();
+    for isa in ["portable", "v3", ""] {
+        let out = t.path().join(if isa.is_empty() { "best" } else { isa });
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_lbdem"));
+        cmd.args(["simulate", path.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        if isa.is_empty() {
+            cmd.env_remove("LBDEM_ISA");
+        } else {
+            cmd.env("LBDEM_ISA", isa);
+        }
+        let o = cmd.output().expect("run lbdem");
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "LBDEM_ISA={isa}: {err}");
+        let level = err
+            .lines()
+            .find_map(|l| l.split_once("SIMD ").map(|(_, r)| r.to_string()))
+            .unwrap_or_else(|| panic!("LBDEM_ISA={isa}: no SIMD level printed in: {err}"));
+        runs.push((isa, out, level));
+    }
+    let (_, base, _) = &runs[0];
+    for (isa, out, level) in &runs[1..] {
+        for f in files {
+            let a = std::fs::read(base.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+            let b = std::fs::read(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+            assert!(
+                a == b,
+                "{f} differs between LBDEM_ISA=portable and LBDEM_ISA={isa:?} ({level})"
+            );
+        }
+    }
+    runs.into_iter().map(|(_, _, level)| level).collect()
+}
+
+/// In a portable build (the default) the three runs take three code paths where the CPU has
+/// AVX-512: baseline, AVX2 + FMA, and AVX-512 with the hand-written lane kernels.
+fn levels_differ_unless_native(levels: &[String]) {
+    #[cfg(target_arch = "x86_64")]
+    let v3 = std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma");
+    #[cfg(not(target_arch = "x86_64"))]
+    let v3 = false;
+    if !lbdem_core::simd::NATIVE_V4 {
+        assert!(levels[0].starts_with("portable"), "{levels:?}");
+        if v3 {
+            assert!(levels[1].starts_with("x86-64-v3"), "{levels:?}");
+        }
+    }
+}
+
+/// Bidisperse disks (radii 0.3 and 0.42 mm) on a lattice closer than their diameters in a
+/// periodic box without walls: they push apart and stay jammed (φ ≈ 0.86), so every step has
+/// contacts, and the list is rebuilt as they move. The linear law without rolling: the fused
+/// all-disk pass, the batched pair and kick kernels (AVX-512 lanes at v4), the list rebuild.
+/// 19 x 21 = 399 disks: full batches of eight and a tail.
+#[test]
+fn dem_disks_give_the_same_bits_at_every_level() {
+    let (nx, ny, a) = (19usize, 21usize, 6.6e-4);
+    let mut csv = String::from("grain_id,x,y,r\n");
+    for j in 0..ny {
+        for i in 0..nx {
+            let k = j * nx + i;
+            let r = if (i + 2 * j) % 3 == 0 { 4.2e-4 } else { 3.0e-4 };
+            // A small deterministic jitter so the disks do not sit on a perfect lattice.
+            let jx = 2.0e-5 * ((k * 7919 % 13) as f64 / 13.0 - 0.5);
+            let jy = 2.0e-5 * ((k * 104_729 % 17) as f64 / 17.0 - 0.5);
+            let x = (i as f64 + 0.5) * a + jx;
+            let y = (j as f64 + 0.5) * a + jy;
+            csv.push_str(&format!("{k},{x},{y},{r}\n"));
+        }
+    }
+    let scene = format!(
+        r#"
+[domain]
+lo = [0.0, 0.0]
+hi = [{lx}, {ly}]
+periodic = [true, true]
+[particles]
+density = 2.6
+csv = "disks.csv"
+[contact]
+law = "linear"
+k_n = 1000.0
+k_t = 500.0
+damping = {{ ratio = 0.3 }}
+mu = 0.5
+[dem]
+dt = 4.0e-6
+skin = 5.0e-5
+[run]
+steps = 3000
+[output]
+series = {{ every = 100 }}
+snapshots = {{ every = 3000 }}
+"#,
+        lx = nx as f64 * a,
+        ly = ny as f64 * a
+    );
+    let levels = same_bits_at_every_level(
+        &scene,
+        &[("disks.csv", csv.as_str())],
+        &[
+            "series.csv",
+            "snapshots/particles_000003000.csv",
+            "snapshots/contacts_000003000.csv",
+        ],
+    );
+    levels_differ_unless_native(&levels);
+}
+
+/// Two-circle grains settling onto the walls of a box with rolling resistance: the pair pass
+/// of the generic law, the per-body gather, the wall forces (`scenes/dry-settle.toml`, shorter).
+#[test]
+fn dem_clumps_on_walls_give_the_same_bits_at_every_level() {
+    let scene = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dry-settle.toml"))
+        .unwrap()
+        .replace("steps = 20000", "steps = 2000")
+        .replace("series = { every = 200 }", "series = { every = 100 }")
+        .replace("snapshots = { every = 5000 }", "snapshots = { every = 2000 }")
+        .replace("checkpoints = { every = 5000 }", "");
+    let levels = same_bits_at_every_level(
+        &scene,
+        &[],
+        &[
+            "series.csv",
+            "snapshots/particles_000002000.csv",
+            "snapshots/contacts_000002000.csv",
+        ],
+    );
+    levels_differ_unless_native(&levels);
+}
+
+/// Grains in a liquid (`scenes/coupled-float.toml`, shorter): the LBM kernels, the PSM
+/// coupling and the DEM sub-steps.
+#[test]
+fn coupled_grains_in_liquid_give_the_same_bits_at_every_level() {
+    let scene =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/coupled-float.toml"))
+            .unwrap()
+            .replace("steps = 1000", "steps = 200")
+            .replace("series = { every = 50 }", "series = { every = 20 }")
+            .replace("snapshots = { every = 500 }", "snapshots = { every = 200 }");
+    let levels = same_bits_at_every_level(
+        &scene,
+        &[],
+        &[
+            "series.csv",
+            "snapshots/fluid_000000200.csv",
+            "snapshots/particles_000000200.csv",
+            "snapshots/contacts_000000200.csv",
+        ],
+    );
+    levels_differ_unless_native(&levels);
 }

@@ -12,10 +12,12 @@
 //! A native build compiles every function for its CPU already: there the cap changes nothing,
 //! and the command line says so.
 //!
-//! STATUS (issue 17 item 8, open): the repository's `.cargo/config.toml` still builds for the
-//! native CPU, because the portable build is slower here (docs/performance.md, "Portable
-//! binaries"): 0.79-1.05x on the LBM benches, 0.41x on the DEM bench, where the lane kernels'
-//! closures and the rest of the DEM stepper run at the baseline level. A native build compiles every level alike ([`NATIVE_V4`]).
+//! A pass with hand-written AVX-512 code (the DEM lane kernels) asks [`is_v4`] inside its op,
+//! a constant in each compiled copy, and takes that code only in the v4 copy.
+//!
+//! The default build (`.cargo/config.toml`, no `target-cpu`) is this portable one: within a few
+//! per cent of a native build on the LBM and DEM benches (docs/performance.md, "Portable
+//! binaries"). A native build compiles every level alike ([`NATIVE_V4`]).
 
 use std::sync::OnceLock;
 
@@ -127,6 +129,21 @@ pub fn dispatch<Op: WithSimd>(op: Op) -> Op::Output {
     arch().dispatch(op)
 }
 
+/// Inside an op run by [`dispatch`]: whether this copy (`S`) runs with AVX-512 (the v4 copy,
+/// or any copy of a build for an AVX-512 CPU), so it may take hand-written AVX-512 code. A
+/// constant in each copy: the other branch is not compiled into it.
+#[inline(always)]
+pub fn is_v4<S: Simd>() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        NATIVE_V4 || std::any::TypeId::of::<S>() == std::any::TypeId::of::<pulp::x86::V4>()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// The whole build targets AVX-512 (x86-64-v4) already.
 pub const NATIVE_V4: bool = cfg!(all(
     target_arch = "x86_64",
@@ -165,6 +182,23 @@ mod tests {
             Level::of(best)
         );
         assert_eq!(scalar.to_bits(), capped(Level::V3).dispatch(Sum(&v)).to_bits());
+    }
+
+    struct V4Here;
+    impl WithSimd for V4Here {
+        type Output = bool;
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, _: S) -> bool {
+            is_v4::<S>()
+        }
+    }
+
+    /// `is_v4` is true in exactly the copy that runs with AVX-512.
+    #[test]
+    fn is_v4_names_the_avx512_copy() {
+        assert_eq!(dispatch(V4Here), level() == Level::V4);
+        assert_eq!(Arch::Scalar.dispatch(V4Here), NATIVE_V4);
+        assert_eq!(capped(Level::V3).dispatch(V4Here), NATIVE_V4);
     }
 
     #[test]

@@ -7,7 +7,9 @@ use crate::domain::Domain;
 use crate::lanes::W;
 use crate::scratch::CircleState;
 use crate::vector::Vec2;
-use lbdem_core::simd::{self, Simd, WithSimd};
+use lbdem_core::simd::Simd;
+#[cfg(test)]
+use lbdem_core::simd::{self, WithSimd};
 
 /// Box constants of one pass.
 pub(crate) struct DiskKick {
@@ -37,11 +39,13 @@ pub(crate) struct Eight<'a> {
     pub hi: [f64; W],
 }
 
+#[inline(always)]
 pub(crate) fn pairs(v: &[Vec2; W]) -> &[[f64; 2]; W] {
     // SAFETY: Vec2 is repr(C): two f64, no padding.
     unsafe { &*(v as *const [Vec2; W]).cast::<[[f64; 2]; W]>() }
 }
 
+#[inline(always)]
 pub(crate) fn pairs_mut(v: &mut [Vec2; W]) -> &mut [[f64; 2]; W] {
     // SAFETY: as above.
     unsafe { &mut *(v as *mut [Vec2; W]).cast::<[[f64; 2]; W]>() }
@@ -63,44 +67,38 @@ impl DiskKick {
 
     /// Kick, drift and lines of eight disks; the largest squared displacement since the list
     /// build (NaN if any is NaN), or None (nothing written) if a disk must take the far wrap.
-    /// The AVX-512 lane copy where the CPU has it, else the array copy compiled for the level
-    /// of `lbdem_core::simd`.
-    #[inline(always)]
+    /// Dispatched on its own (the tests); the stepper calls [`DiskKick::eight_in`] inside its
+    /// dispatched pass.
+    #[cfg(test)]
     pub(crate) fn eight(&self, e: Eight<'_>) -> Option<f64> {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if crate::lanes::NATIVE_AVX512 {
-                // The build targets AVX-512: the lane code inlines here (a call through
-                // `eight_avx512` cost 8 % of the 10k DEM bench).
-                return crate::on_avx512::kick::eight(self, e);
-            }
-            if crate::lanes::avx512_ok() {
-                // SAFETY: the CPU has the features `eight_avx512` enables (`avx512_ok`).
-                return unsafe { eight_avx512(self, e) };
-            }
-        }
         simd::dispatch(EightOp { k: self, e })
+    }
+
+    /// [`DiskKick::eight`] inside an op dispatched at level `S`: the AVX-512 lanes in the v4
+    /// copy, the array lanes in the others.
+    #[inline(always)]
+    pub(crate) fn eight_in<S: Simd>(&self, e: Eight<'_>) -> Option<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx512_in::<S>() {
+            return crate::on_avx512::kick::eight(self, e);
+        }
+        crate::on_arrays::kick::eight(self, e)
     }
 }
 
+#[cfg(test)]
 struct EightOp<'a, 'b> {
     k: &'a DiskKick,
     e: Eight<'b>,
 }
 
+#[cfg(test)]
 impl WithSimd for EightOp<'_, '_> {
     type Output = Option<f64>;
     #[inline(always)]
     fn with_simd<S: Simd>(self, _: S) -> Option<f64> {
-        crate::on_arrays::kick::eight(self.k, self.e)
+        self.k.eight_in::<S>(self.e)
     }
-}
-
-/// The AVX-512 lane copy, compiled with the features its intrinsics need.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw,avx512cd")]
-unsafe fn eight_avx512(k: &DiskKick, e: Eight<'_>) -> Option<f64> {
-    crate::on_avx512::kick::eight(k, e)
 }
 
 #[cfg(test)]

@@ -18,15 +18,42 @@ struct Consts {
 impl Consts {
     #[inline(always)]
     fn of(k: &DiskKick) -> Self {
-        let two = |v: [f64; 2]| [F8::splat(v[0]), F8::splat(v[1])];
         Self {
             dt: F8::splat(k.dt),
-            lo: two(k.lo),
-            hi: two(k.hi),
-            len: two(k.len),
-            half: two(k.half),
+            lo: [F8::splat(k.lo[0]), F8::splat(k.lo[1])],
+            hi: [F8::splat(k.hi[0]), F8::splat(k.hi[1])],
+            len: [F8::splat(k.len[0]), F8::splat(k.len[1])],
+            half: [F8::splat(k.half[0]), F8::splat(k.half[1])],
         }
     }
+}
+
+// Functions, not closures: a closure would be compiled without the features of the
+// `#[target_feature]` entry, and the AVX-512 intrinsics would stay calls.
+
+/// One conditional shift per periodic axis (Domain::wrap).
+#[inline(always)]
+fn wrap(p: F8, periodic: bool, c: &Consts, k: usize) -> F8 {
+    if periodic {
+        let below = p.lt(c.lo[k]);
+        let above = p.ge(c.hi[k]);
+        below.select(p + c.len[k], above.select(p - c.len[k], p))
+    } else {
+        p
+    }
+}
+
+/// A lane still outside the box after one shift (it must take the far wrap).
+#[inline(always)]
+fn far(p: F8, periodic: bool, c: &Consts, k: usize) -> bool {
+    periodic && p.outside(c.lo[k], c.hi[k]).any()
+}
+
+/// Domain::min_image along axis k.
+#[inline(always)]
+fn min_image(d: F8, c: &Consts, k: usize) -> F8 {
+    let shift = d.abs().gt(c.half[k]);
+    shift.select(d - c.len[k].copysign(d), d)
 }
 
 /// Kick, drift and lines of eight disks; the largest squared displacement since the list
@@ -43,29 +70,15 @@ pub(crate) fn eight(kd: &DiskKick, e: Eight<'_>) -> Option<f64> {
     vy = vy + fy * hm;
     let w = F8::from_array(*e.w) + F8::from_array(*e.t) * hi;
     // x = wrap(x + v dt): one conditional shift per periodic axis (Domain::wrap)
-    let wrap = |p: F8, k: usize| {
-        if kd.periodic[k] {
-            let below = p.lt(c.lo[k]);
-            let above = p.ge(c.hi[k]);
-            below.select(p + c.len[k], above.select(p - c.len[k], p))
-        } else {
-            p
-        }
-    };
-    let x = wrap(x0 + vx * c.dt, 0);
-    let y = wrap(y0 + vy * c.dt, 1);
-    let far = |p: F8, k: usize| kd.periodic[k] && p.outside(c.lo[k], c.hi[k]).any();
-    if far(x, 0) || far(y, 1) {
+    let x = wrap(x0 + vx * c.dt, kd.periodic[0], &c, 0);
+    let y = wrap(y0 + vy * c.dt, kd.periodic[1], &c, 1);
+    if far(x, kd.periodic[0], &c, 0) || far(y, kd.periodic[1], &c, 1) {
         return None;
     }
     let a = F8::from_array(*e.a) + w * c.dt;
     // Displacement since the list build (Domain::min_image, norm2).
     let (rx, ry) = deinterleave(pairs(e.refp));
-    let min_image = |d: F8, k: usize| {
-        let shift = d.abs().gt(c.half[k]);
-        shift.select(d - c.len[k].copysign(d), d)
-    };
-    let (dx, dy) = (min_image(x - rx, 0), min_image(y - ry, 1));
+    let (dx, dy) = (min_image(x - rx, &c, 0), min_image(y - ry, &c, 1));
     let d2 = (dx * dx + dy * dy).to_array();
     interleave(vx, vy, pairs_mut(e.v));
     interleave(x, y, pairs_mut(e.x));

@@ -8,6 +8,7 @@ use crate::domain::Domain;
 use crate::error::DemError;
 use crate::history::Histories;
 use crate::vector::Vec2;
+use lbdem_core::simd::{self, Simd, WithSimd};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -106,60 +107,113 @@ impl CellList {
             self.sorted[fill[c as usize] as usize] = i as u32;
             fill[c as usize] += 1;
         }
-        // Neighbour cell offsets, deduplicated when a periodic axis has fewer than 3 cells.
-        let cs = &self.cell_start;
-        let sorted = &self.sorted;
+        let search = Search {
+            dom,
+            nx,
+            ny,
+            cells: &cells,
+            cs: &self.cell_start,
+            sorted: &self.sorted,
+            pos,
+            r,
+            body,
+            skin,
+            range: &range,
+        };
         let chunks: Vec<Vec<[u32; 2]>> = (0..n.div_ceil(BUILD_CHUNK))
             .into_par_iter()
-            .map(|k| {
-                let mut out = Vec::new();
-                let mut nb: Vec<u32> = Vec::new();
-                let mut ncells: Vec<usize> = Vec::with_capacity(9);
-                for i in k * BUILD_CHUNK..((k + 1) * BUILD_CHUNK).min(n) {
-                    let c = cells[i] as usize;
-                    let (ix, iy) = ((c % nx) as isize, (c / nx) as isize);
-                    ncells.clear();
-                    for dy in -1..=1isize {
-                        for dx in -1..=1isize {
-                            let (mut jx, mut jy) = (ix + dx, iy + dy);
-                            if dom.periodic[0] {
-                                jx = jx.rem_euclid(nx as isize);
-                            } else if jx < 0 || jx >= nx as isize {
-                                continue;
-                            }
-                            if dom.periodic[1] {
-                                jy = jy.rem_euclid(ny as isize);
-                            } else if jy < 0 || jy >= ny as isize {
-                                continue;
-                            }
-                            let cc = jy as usize * nx + jx as usize;
-                            if !ncells.contains(&cc) {
-                                ncells.push(cc);
-                            }
-                        }
-                    }
-                    nb.clear();
-                    let (pi, ri, bi) = (pos[i], r[i], body[i]);
-                    for &cc in &ncells {
-                        for &j in &sorted[cs[cc] as usize..cs[cc + 1] as usize] {
-                            if (j as usize) <= i || body[j as usize] == bi {
-                                continue;
-                            }
-                            let d = dom.min_image(pos[j as usize] - pi);
-                            let rj = r[j as usize];
-                            let rc = ri + rj + range(ri, rj) + skin;
-                            if d.x * d.x + d.y * d.y < rc * rc {
-                                nb.push(j);
-                            }
-                        }
-                    }
-                    nb.sort_unstable();
-                    out.extend(nb.iter().map(|&j| [i as u32, j]));
-                }
-                out
-            })
+            .map(|k| simd::dispatch(SearchChunk { s: &search, k }))
             .collect();
         Ok(chunks.concat())
+    }
+}
+
+/// What the pair search of one chunk of circles reads.
+struct Search<'a, R> {
+    dom: &'a Domain,
+    nx: usize,
+    ny: usize,
+    cells: &'a [u32],
+    cs: &'a [u32],
+    sorted: &'a [u32],
+    pos: &'a [Vec2],
+    r: &'a [f64],
+    body: &'a [u32],
+    skin: f64,
+    range: &'a R,
+}
+
+/// The pairs (i, j > i) of circles `k BUILD_CHUNK..(k + 1) BUILD_CHUNK`, in order; one op of
+/// `lbdem_core::simd::dispatch`.
+struct SearchChunk<'a, 'b, R> {
+    s: &'b Search<'a, R>,
+    k: usize,
+}
+
+impl<R: Fn(f64, f64) -> f64 + Sync> WithSimd for SearchChunk<'_, '_, R> {
+    type Output = Vec<[u32; 2]>;
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) -> Vec<[u32; 2]> {
+        let Search {
+            dom,
+            nx,
+            ny,
+            cells,
+            cs,
+            sorted,
+            pos,
+            r,
+            body,
+            skin,
+            range,
+        } = *self.s;
+        let (k, n) = (self.k, pos.len());
+        let mut out = Vec::new();
+        let mut nb: Vec<u32> = Vec::new();
+        // Neighbour cells, deduplicated when a periodic axis has fewer than 3 cells.
+        let mut ncells: Vec<usize> = Vec::with_capacity(9);
+        for i in k * BUILD_CHUNK..((k + 1) * BUILD_CHUNK).min(n) {
+            let c = cells[i] as usize;
+            let (ix, iy) = ((c % nx) as isize, (c / nx) as isize);
+            ncells.clear();
+            for dy in -1..=1isize {
+                for dx in -1..=1isize {
+                    let (mut jx, mut jy) = (ix + dx, iy + dy);
+                    if dom.periodic[0] {
+                        jx = jx.rem_euclid(nx as isize);
+                    } else if jx < 0 || jx >= nx as isize {
+                        continue;
+                    }
+                    if dom.periodic[1] {
+                        jy = jy.rem_euclid(ny as isize);
+                    } else if jy < 0 || jy >= ny as isize {
+                        continue;
+                    }
+                    let cc = jy as usize * nx + jx as usize;
+                    if !ncells.contains(&cc) {
+                        ncells.push(cc);
+                    }
+                }
+            }
+            nb.clear();
+            let (pi, ri, bi) = (pos[i], r[i], body[i]);
+            for &cc in &ncells {
+                for &j in &sorted[cs[cc] as usize..cs[cc + 1] as usize] {
+                    if (j as usize) <= i || body[j as usize] == bi {
+                        continue;
+                    }
+                    let d = dom.min_image(pos[j as usize] - pi);
+                    let rj = r[j as usize];
+                    let rc = ri + rj + range(ri, rj) + skin;
+                    if d.x * d.x + d.y * d.y < rc * rc {
+                        nb.push(j);
+                    }
+                }
+            }
+            nb.sort_unstable();
+            out.extend(nb.iter().map(|&j| [i as u32, j]));
+        }
+        out
     }
 }
 

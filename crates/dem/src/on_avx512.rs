@@ -1,5 +1,6 @@
-//! The lane kernels compiled with AVX-512 registers (`crate::lanes::avx512`); entered only
-//! from `#[target_feature]` functions called where the CPU has the features.
+//! The lane kernels compiled with AVX-512 registers (`crate::lanes::avx512`); taken only inside
+//! the v4 copy of a pass dispatched by `lbdem_core::simd` (`crate::lanes::avx512_in`), where
+//! the CPU has the features, or in a native build for such a CPU.
 
 use crate::lanes::avx512 as lanes;
 

@@ -61,7 +61,13 @@ fn run_damp<const GAMMA: bool>(
             let hx = F8::from_array(std::array::from_fn(|k| hist[lane(k)].xi_t.x));
             let hy = F8::from_array(std::array::from_fn(|k| hist[lane(k)].xi_t.y));
             let r = eight::<GAMMA>(kp, &ci, &cj, hx, hy);
-            let [xix, xiy, fx, fy, ti, tj] = [r.xix, r.xiy, r.fx, r.fy, r.ti, r.tj].map(F8::to_array);
+            let (xix, xiy, fx, fy) = (
+                r.xix.to_array(),
+                r.xiy.to_array(),
+                r.fx.to_array(),
+                r.fy.to_array(),
+            );
+            let (ti, tj) = (r.ti.to_array(), r.tj.to_array());
             for k in 0..m {
                 let h = &mut hist[q + k];
                 let t = r.touch.bit(k);
@@ -86,12 +92,8 @@ fn run_damp<const GAMMA: bool>(
 #[inline(always)]
 fn eight<const GAMMA: bool>(kp: &LinearPair, ci: &Lanes, cj: &Lanes, hx: F8, hy: F8) -> LaneOut {
     let zero = F8::splat(0.0);
-    let min_image = |d: F8, k: usize| {
-        let shift = d.abs().gt(F8::splat(kp.half[k]));
-        shift.select(d - F8::splat(kp.l[k]).copysign(d), d)
-    };
-    let dx = min_image(cj.x - ci.x, 0);
-    let dy = min_image(cj.y - ci.y, 1);
+    let dx = min_image(cj.x - ci.x, kp.half[0], kp.l[0]);
+    let dy = min_image(cj.y - ci.y, kp.half[1], kp.l[1]);
     let (ri, rj) = (ci.r, cj.r);
     let rs = ri + rj;
     let d2 = dx * dx + dy * dy;
@@ -157,6 +159,15 @@ fn eight<const GAMMA: bool>(kp: &LinearPair, ci: &Lanes, cj: &Lanes, hx: F8, hy:
         ti: touching.select(ti, zero),
         tj: touching.select(tj, zero),
     }
+}
+
+/// `Domain::min_image` along one axis: d shifted by one box length `l` when |d| > `half`.
+/// A function, not a closure: a closure would be compiled without the features of the
+/// `#[target_feature]` entry, and the AVX-512 intrinsics would stay calls.
+#[inline(always)]
+fn min_image(d: F8, half: f64, l: f64) -> F8 {
+    let shift = d.abs().gt(F8::splat(half));
+    shift.select(d - F8::splat(l).copysign(d), d)
 }
 
 struct LaneOut {

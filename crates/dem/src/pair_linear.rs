@@ -6,7 +6,7 @@
 use crate::contact::{Damping, History, LinearSpringDashpot};
 use crate::domain::Domain;
 use crate::scratch::{CircleState, PairOut};
-use lbdem_core::simd::{self, Simd, WithSimd};
+use lbdem_core::simd::Simd;
 
 /// The law and box constants of one force evaluation.
 #[derive(Clone, Copy, Debug)]
@@ -55,8 +55,11 @@ impl LinearPair {
     }
 
     /// Evaluate `pairs` (with their `hist`), writing each pair's force on i and torques on i
-    /// and j to `out` and 1/0 (touching or not) to `touch`.
-    pub(crate) fn run(
+    /// and j to `out` and 1/0 (touching or not) to `touch`. Runs inside an op of
+    /// `lbdem_core::simd::dispatch` at level `S` (the stepper's passes): the AVX-512 lanes in
+    /// the v4 copy, the array lanes in the others.
+    #[inline(always)]
+    pub(crate) fn run_in<S: Simd>(
         &self,
         cst: &[CircleState],
         pairs: &[[u32; 2]],
@@ -65,63 +68,9 @@ impl LinearPair {
         touch: &mut [u8],
     ) {
         #[cfg(target_arch = "x86_64")]
-        {
-            if crate::lanes::NATIVE_AVX512 {
-                // The build targets AVX-512: no `#[target_feature]` call in between.
-                return crate::on_avx512::pair::run(self, cst, pairs, hist, out, touch);
-            }
-            if crate::lanes::avx512_ok() {
-                // SAFETY: the CPU has the features `run_avx512` enables (`avx512_ok`).
-                return unsafe { run_avx512(self, cst, pairs, hist, out, touch) };
-            }
+        if crate::lanes::avx512_in::<S>() {
+            return crate::on_avx512::pair::run(self, cst, pairs, hist, out, touch);
         }
-        simd::dispatch(Run {
-            k: self,
-            cst,
-            pairs,
-            hist,
-            out,
-            touch,
-        })
-    }
-}
-
-/// The AVX-512 lane copy, compiled with the features its intrinsics need.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw,avx512cd")]
-unsafe fn run_avx512(
-    k: &LinearPair,
-    cst: &[CircleState],
-    pairs: &[[u32; 2]],
-    hist: &mut [History],
-    out: &mut [PairOut],
-    touch: &mut [u8],
-) {
-    crate::on_avx512::pair::run(k, cst, pairs, hist, out, touch)
-}
-
-/// The array lane copy, compiled for each instruction-set level (`lbdem_core::simd`).
-struct Run<'a> {
-    k: &'a LinearPair,
-    cst: &'a [CircleState],
-    pairs: &'a [[u32; 2]],
-    hist: &'a mut [History],
-    out: &'a mut [PairOut],
-    touch: &'a mut [u8],
-}
-
-impl WithSimd for Run<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn with_simd<S: Simd>(self, _: S) {
-        let Run {
-            k,
-            cst,
-            pairs,
-            hist,
-            out,
-            touch,
-        } = self;
-        crate::on_arrays::pair::run(k, cst, pairs, hist, out, touch)
+        crate::on_arrays::pair::run(self, cst, pairs, hist, out, touch)
     }
 }

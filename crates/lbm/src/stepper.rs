@@ -130,39 +130,42 @@ fn run_rows<L: Lattice, T: Real, C: Collider<L, T>>(row_good: &mut [bool], ctx: 
         .par_chunks_mut(ROWS_PER_TASK)
         .enumerate()
         .for_each(|(c, flags)| {
-            simd::dispatch(Rows::<L, T, C> {
-                ctx,
-                first: c * ROWS_PER_TASK,
-                flags,
-                forced,
-                _l: PhantomData,
-            })
+            let first = c * ROWS_PER_TASK;
+            // One kernel variant per dispatched copy, as the AA stepper (`stepper_aa.rs`).
+            if forced {
+                simd::dispatch(Rows::<L, T, C, true> {
+                    ctx,
+                    first,
+                    flags,
+                    _l: PhantomData,
+                })
+            } else {
+                simd::dispatch(Rows::<L, T, C, false> {
+                    ctx,
+                    first,
+                    flags,
+                    _l: PhantomData,
+                })
+            }
         });
 }
 
-/// One task's rows, compiled for each instruction-set level (`lbdem_core::simd`).
-struct Rows<'a, L, T, C> {
+/// One task's rows (forced or not), compiled for each instruction-set level
+/// (`lbdem_core::simd`).
+struct Rows<'a, L, T, C, const F: bool> {
     ctx: &'a Ctx<'a, T, C>,
     first: usize,
     flags: &'a mut [bool],
-    forced: bool,
     _l: PhantomData<L>,
 }
 
-impl<L: Lattice, T: Real, C: Collider<L, T>> WithSimd for Rows<'_, L, T, C> {
+impl<L: Lattice, T: Real, C: Collider<L, T>, const F: bool> WithSimd for Rows<'_, L, T, C, F> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: Simd>(self, _: S) {
         for (k, g) in self.flags.iter_mut().enumerate() {
-            let r = self.first + k;
             // SAFETY: each row index belongs to exactly one chunk.
-            *g = unsafe {
-                if self.forced {
-                    kernel::row::<L, T, C, true>(self.ctx, r)
-                } else {
-                    kernel::row::<L, T, C, false>(self.ctx, r)
-                }
-            };
+            *g = unsafe { kernel::row::<L, T, C, F>(self.ctx, self.first + k) };
         }
     }
 }

@@ -1,10 +1,13 @@
 //! The eight lanes as AVX-512 registers and masks, and the line transposes of the pair kernel.
 //!
+//! No closure holds an intrinsic (a closure is compiled without its caller's target features,
+//! so the intrinsic would stay a call): loops and explicit arrays instead of `map`/`from_fn`.
+//!
 //! Every function here is `#[inline(always)]` without `#[target_feature]`: it is compiled only
 //! into callers that enable AVX-512 F and DQ, the lane kernels' AVX-512 copy
-//! (`crate::on_avx512`), entered only after `crate::lanes::avx512_ok` saw the CPU has them, or
-//! a whole `target-cpu=native` build for such a CPU. Data movement and the scalar IEEE
-//! operations per lane: the bits are those of `super::portable`.
+//! (`crate::on_avx512`), taken only in the v4 copy of a pass dispatched by `lbdem_core::simd`
+//! (`crate::lanes::avx512_in`), or a whole `target-cpu=native` build for such a CPU. Data
+//! movement and the scalar IEEE operations per lane: the bits are those of `super::portable`.
 
 use super::W;
 use crate::contact::History;
@@ -136,14 +139,19 @@ pub(crate) fn interleave(x: F8, y: F8, p: &mut [[f64; 2]; W]) {
 /// 8 x 8 transpose (lanes of column k become row k).
 #[inline(always)]
 pub(crate) fn transpose(r: [F8; W]) -> [[f64; W]; W] {
-    transpose_registers(r).map(F8::to_array)
+    let t = transpose_registers(r);
+    let mut rows = [[0.0; W]; W];
+    for (row, v) in rows.iter_mut().zip(t) {
+        *row = v.to_array();
+    }
+    rows
 }
 
 /// 8 x 8 transpose kept in registers: lane k of result j is lane j of input k.
 #[inline(always)]
 pub(crate) fn transpose_registers(r: [F8; W]) -> [F8; W] {
     unsafe {
-        let r = r.map(|v| v.0);
+        let r = [r[0].0, r[1].0, r[2].0, r[3].0, r[4].0, r[5].0, r[6].0, r[7].0];
         let t = [
             _mm512_unpacklo_pd(r[0], r[1]),
             _mm512_unpackhi_pd(r[0], r[1]),
@@ -174,7 +182,16 @@ pub(crate) fn transpose_registers(r: [F8; W]) -> [F8; W] {
             _mm512_shuffle_f64x2::<0xDD>(u[1], u[5]),
             _mm512_shuffle_f64x2::<0xDD>(u[3], u[7]),
         ];
-        c.map(F8)
+        [
+            F8(c[0]),
+            F8(c[1]),
+            F8(c[2]),
+            F8(c[3]),
+            F8(c[4]),
+            F8(c[5]),
+            F8(c[6]),
+            F8(c[7]),
+        ]
     }
 }
 
@@ -197,11 +214,6 @@ impl M8 {
 
 // The line moves of the pair kernel: shuffles instead of eight scalar loads per field.
 
-#[inline(always)]
-fn m512(v: F8) -> __m512d {
-    v.0
-}
-
 /// Columns 0..7 of the eight lines `cst[idx[k]]`.
 #[inline(always)]
 pub(crate) fn transpose8(cst: &[CircleState], idx: &[usize; W]) -> [F8; 8] {
@@ -209,8 +221,11 @@ pub(crate) fn transpose8(cst: &[CircleState], idx: &[usize; W]) -> [F8; 8] {
     // SAFETY: AVX-512 code runs only where the CPU has it (module doc); every idx[k] < cst.len()
     // (asserted by the caller); CircleState is repr(C), 64 bytes, 64-byte aligned, eight f64.
     unsafe {
-        let r: [__m512d; 8] = std::array::from_fn(|k| _mm512_load_pd(p.add(idx[k]).cast::<f64>()));
-        transpose_registers(r.map(F8))
+        let mut r = [F8(_mm512_setzero_pd()); W];
+        for (v, &i) in r.iter_mut().zip(idx) {
+            *v = F8(_mm512_load_pd(p.add(i).cast::<f64>()));
+        }
+        transpose_registers(r)
     }
 }
 
@@ -221,7 +236,12 @@ pub(crate) fn hist_load(h: &[History; W]) -> (F8, F8, [F8; 2]) {
     // SAFETY: as above; eight repr(C) Histories = 32 f64, read as four
     // unaligned lines.
     unsafe {
-        let l: [__m512d; 4] = std::array::from_fn(|k| _mm512_loadu_pd(p.add(8 * k)));
+        let l = [
+            _mm512_loadu_pd(p),
+            _mm512_loadu_pd(p.add(8)),
+            _mm512_loadu_pd(p.add(16)),
+            _mm512_loadu_pd(p.add(24)),
+        ];
         let (xy, tp) = (
             _mm512_setr_epi64(0, 4, 8, 12, 1, 5, 9, 13),
             _mm512_setr_epi64(2, 6, 10, 14, 3, 7, 11, 15),
@@ -245,7 +265,7 @@ pub(crate) fn hist_load(h: &[History; W]) -> (F8, F8, [F8; 2]) {
 /// Eight records of four f64 from four lane vectors (the inverse of [`hist_load`]).
 #[inline(always)]
 pub(crate) fn store4(h: &mut [[f64; 4]; W], v: [F8; 4]) {
-    let [x, y, t, dp] = v.map(m512);
+    let [x, y, t, dp] = [v[0].0, v[1].0, v[2].0, v[3].0];
     // SAFETY: as above; writes the 32 f64 of `h`.
     unsafe {
         let idx = [

@@ -4,9 +4,9 @@
 //!
 //! Two lane types with the same interface: [`avx512`] (one register per value, one mask
 //! register per mask) and [`portable`] (arrays the compiler vectorises). The kernels that use
-//! them are written once and compiled for each (`crate::on_avx512`, `crate::on_arrays`); the
-//! AVX-512 copy runs when [`avx512_ok`], the array copy otherwise, itself compiled for every
-//! level of `lbdem_core::simd`.
+//! them are written once and compiled for each (`crate::on_avx512`, `crate::on_arrays`). Whole
+//! passes (a chunk of disks, a chunk of pairs) are dispatched once by `lbdem_core::simd`; the
+//! v4 copy takes the AVX-512 lanes, the others the array lanes ([`avx512_in`]).
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx512;
@@ -15,19 +15,13 @@ pub(crate) mod portable;
 /// Lanes per batch (eight f64 = one AVX-512 register).
 pub(crate) const W: usize = 8;
 
-/// The whole build targets x86-64-v4 (`-C target-cpu=native` here): the AVX-512 copies are
-/// called directly, without a `#[target_feature]` call in between.
-pub(crate) const NATIVE_AVX512: bool = lbdem_core::simd::NATIVE_V4;
-
-/// Whether the AVX-512 copies may run: `lbdem_core::simd` runs this process at x86-64-v4
-/// (the CPU has every feature the copies' `#[target_feature]` entries enable). `LBDEM_ISA`
-/// below v4 turns them off, except in a native build (`NATIVE_AVX512`), where every function
-/// is compiled for v4 anyway.
+/// Inside an op run by `lbdem_core::simd::dispatch`, compiled for level `S`: whether this copy
+/// takes the AVX-512 lanes ([`avx512`], `crate::on_avx512`) instead of the array lanes. True in
+/// the v4 copy (entered only where the CPU has AVX-512 and `LBDEM_ISA` allows it) and in every
+/// copy of a build for an AVX-512 CPU; a constant in each copy, so a copy holds one lane type.
 ///
-/// The functions of `avx512` and of `crate::on_avx512` are safe to call only under this (or
-/// `NATIVE_AVX512`); they are reached only through `pair_linear.rs` and `kick_disks.rs`.
-#[cfg(target_arch = "x86_64")]
+/// The functions of `avx512` and of `crate::on_avx512` are safe to run only under this.
 #[inline(always)]
-pub(crate) fn avx512_ok() -> bool {
-    lbdem_core::simd::level() == lbdem_core::simd::Level::V4
+pub(crate) fn avx512_in<S: lbdem_core::simd::Simd>() -> bool {
+    cfg!(target_arch = "x86_64") && lbdem_core::simd::is_v4::<S>()
 }

@@ -6,12 +6,13 @@
 //! follow in a second pass.
 
 use super::finish::{Bodies5, Finish};
-use super::pairs::{circle_sum, generic_pairs, linear_kernel};
+use super::pairs::{Generic, PairKernel, circle_sum, linear_kernel};
 use super::{CIRCLE_CHUNK, Stepper};
 use crate::contact::{ContactLaw, History};
-use crate::scratch::{CircleState, PairOut};
+use crate::scratch::{CircleState, Kick, PairOut};
 use crate::system::System;
 use crate::vector::Vec2;
+use lbdem_core::simd::{self, Simd, WithSimd};
 use rayon::prelude::*;
 
 impl Stepper {
@@ -21,37 +22,151 @@ impl Stepper {
         match linear_kernel(law, &dom, dt) {
             Some(k) => {
                 let hist = sys.contacts.hist.conform::<History>(n);
-                fused(
-                    self,
-                    fin,
-                    &sys.contacts.pairs,
-                    hist,
-                    &mut sys.bodies,
-                    |cst, pr, h, o, t| k.run(cst, pr, h, o, t),
-                );
+                fused(self, fin, &sys.contacts.pairs, hist, &mut sys.bodies, &k);
             }
             None => {
                 let hist = sys.contacts.hist.conform::<L::History>(n);
-                fused(
-                    self,
-                    fin,
-                    &sys.contacts.pairs,
-                    hist,
-                    &mut sys.bodies,
-                    |cst, pr, h, o, t| generic_pairs(law, &dom, dt, cst, pr, h, o, t),
-                );
+                let k = Generic { law, dom, dt };
+                fused(self, fin, &sys.contacts.pairs, hist, &mut sys.bodies, &k);
             }
         }
     }
 }
 
-fn fused<H: Send>(
+/// What the finish of a circle reads: the pair tables and the bodies' constants.
+#[derive(Clone, Copy)]
+struct Tables<'a> {
+    fin: &'a Finish,
+    ps: &'a [u32],
+    js: &'a [u32],
+    jl: &'a [u32],
+    kick: &'a [Kick],
+    mass: &'a [f64],
+    inertia: &'a [f64],
+    ext_force: &'a [Vec2],
+    ext_torque: &'a [f64],
+}
+
+impl Tables<'_> {
+    /// Sum of circle c and its finish; `out` holds the pairs from `base` on.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn finish(
+        &self,
+        c: usize,
+        out: &[PairOut],
+        base: usize,
+        f: &mut Vec2,
+        t: &mut f64,
+        v: &mut Vec2,
+        w: &mut f64,
+    ) {
+        (*f, *t) = circle_sum(out, base, self.ps, self.js, self.jl, c);
+        self.fin.apply(
+            f,
+            t,
+            v,
+            w,
+            self.mass[c],
+            self.inertia[c],
+            &self.kick[c],
+            self.ext_force[c],
+            self.ext_torque[c],
+        );
+    }
+}
+
+/// One chunk of circles: its pairs, then the finish of every circle without a partner in an
+/// earlier chunk; one op of `lbdem_core::simd::dispatch`.
+struct Chunk<'a, K: PairKernel> {
+    kernel: &'a K,
+    tab: Tables<'a>,
+    cst: &'a [CircleState],
+    pairs: &'a [[u32; 2]],
+    skip: &'a [u32],
+    c0: usize,
+    hist: &'a mut [K::H],
+    out: &'a mut [PairOut],
+    touch: &'a mut [u8],
+    f: &'a mut [Vec2],
+    t: &'a mut [f64],
+    v: &'a mut [Vec2],
+    w: &'a mut [f64],
+}
+
+impl<K: PairKernel> WithSimd for Chunk<'_, K> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let Chunk {
+            kernel,
+            tab,
+            cst,
+            pairs,
+            skip,
+            c0,
+            hist,
+            out,
+            touch,
+            f,
+            t,
+            v,
+            w,
+        } = self;
+        let base = tab.ps[c0] as usize;
+        kernel.run::<S>(cst, pairs, hist, out, touch);
+        let mut skip = skip.iter().peekable();
+        for l in 0..f.len() {
+            let c = c0 + l;
+            if skip.peek().is_some_and(|&&d| d as usize == c) {
+                skip.next();
+                continue;
+            }
+            tab.finish(c, out, base, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
+        }
+    }
+}
+
+/// The deferred circles of one chunk, once every pair is done.
+struct Deferred<'a> {
+    tab: Tables<'a>,
+    out: &'a [PairOut],
+    list: &'a [u32],
+    c0: usize,
+    f: &'a mut [Vec2],
+    t: &'a mut [f64],
+    v: &'a mut [Vec2],
+    w: &'a mut [f64],
+}
+
+impl WithSimd for Deferred<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let Deferred {
+            tab,
+            out,
+            list,
+            c0,
+            f,
+            t,
+            v,
+            w,
+        } = self;
+        for &c in list {
+            let l = c as usize - c0;
+            tab.finish(c as usize, out, 0, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
+        }
+    }
+}
+
+fn fused<K: PairKernel>(
     st: &mut Stepper,
     fin: &Finish,
     pairs: &[[u32; 2]],
-    hist: &mut [H],
+    hist: &mut [K::H],
     bodies: &mut crate::body::Bodies,
-    kernel: impl Fn(&[CircleState], &[[u32; 2]], &mut [H], &mut [PairOut], &mut [u8]) + Sync,
+    kernel: &K,
 ) {
     let (cst, ps, js, jl, kick) = (&st.cstate, &st.pair_start, &st.j_start, &st.j_list, &st.kick);
     let (deferred, dstart) = (&st.deferred, &st.deferred_start);
@@ -67,22 +182,17 @@ fn fused<H: Send>(
         ..
     } = Bodies5::of(bodies);
     let nc = force.len();
-    // Sum of circle c and its finish; `out` holds the pairs from `base` on.
-    let finish =
-        |c: usize, out: &[PairOut], base: usize, f: &mut Vec2, t: &mut f64, v: &mut Vec2, w: &mut f64| {
-            (*f, *t) = circle_sum(out, base, ps, js, jl, c);
-            fin.apply(
-                f,
-                t,
-                v,
-                w,
-                mass[c],
-                inertia[c],
-                &kick[c],
-                ext_force[c],
-                ext_torque[c],
-            );
-        };
+    let tab = Tables {
+        fin,
+        ps,
+        js,
+        jl,
+        kick,
+        mass,
+        inertia,
+        ext_force,
+        ext_torque,
+    };
     {
         let mut tasks = Vec::with_capacity(nc.div_ceil(CIRCLE_CHUNK));
         let (mut hist, mut out, mut touch) = (hist, &mut st.out[..], &mut st.touch[..]);
@@ -105,19 +215,21 @@ fn fused<H: Send>(
             .for_each(|(k, hist, out, touch, ((f, t), (v, w)))| {
                 let c0 = k * CIRCLE_CHUNK;
                 let base = ps[c0] as usize;
-                let pr = &pairs[base..base + out.len()];
-                kernel(cst, pr, hist, out, touch);
-                let mut skip = deferred[dstart[k] as usize..dstart[k + 1] as usize]
-                    .iter()
-                    .peekable();
-                for l in 0..f.len() {
-                    let c = c0 + l;
-                    if skip.peek().is_some_and(|&&d| d as usize == c) {
-                        skip.next();
-                        continue;
-                    }
-                    finish(c, out, base, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
-                }
+                simd::dispatch(Chunk {
+                    kernel,
+                    tab,
+                    cst,
+                    pairs: &pairs[base..base + out.len()],
+                    skip: &deferred[dstart[k] as usize..dstart[k + 1] as usize],
+                    c0,
+                    hist,
+                    out,
+                    touch,
+                    f,
+                    t,
+                    v,
+                    w,
+                })
             });
     }
     // Circles with a partner in an earlier chunk, now that every pair is done.
@@ -131,10 +243,15 @@ fn fused<H: Send>(
         )
         .enumerate()
         .for_each(|(k, ((f, t), (v, w)))| {
-            let c0 = k * CIRCLE_CHUNK;
-            for &c in &deferred[dstart[k] as usize..dstart[k + 1] as usize] {
-                let l = c as usize - c0;
-                finish(c as usize, out, 0, &mut f[l], &mut t[l], &mut v[l], &mut w[l]);
-            }
+            simd::dispatch(Deferred {
+                tab,
+                out,
+                list: &deferred[dstart[k] as usize..dstart[k + 1] as usize],
+                c0: k * CIRCLE_CHUNK,
+                f,
+                t,
+                v,
+                w,
+            })
         });
 }

@@ -1,16 +1,19 @@
 //! Opening half kick and drift; world positions, arms and packed lines of the circles.
 
 use super::{BODY_CHUNK, Stepper};
+use crate::domain::Domain;
 use crate::kick_disks::{DiskKick, Eight};
 use crate::lanes::W;
-use crate::scratch::{CircleState, nan_max};
+use crate::scratch::{CircleState, Kick, nan_max};
 use crate::system::System;
 use crate::vector::{Vec2, Vector};
+use lbdem_core::simd::{self, Simd, WithSimd};
 use rayon::prelude::*;
 
 impl Stepper {
     /// [`Stepper::kick_drift`] and [`Stepper::update_circles`] in one pass when every body is a
-    /// single centred circle (circle k = body k).
+    /// single centred circle (circle k = body k). Each chunk is one op of
+    /// `lbdem_core::simd::dispatch`: the AVX-512 lanes at v4, the array lanes at the other levels.
     pub(super) fn kick_drift_disks(&mut self, sys: &mut System, h: f64, dt: f64) -> f64 {
         let dom = sys.domain;
         let b = &mut sys.bodies;
@@ -30,59 +33,24 @@ impl Stepper {
             .enumerate()
             .map(|(c, (((x, v), (a, w)), (st, kc)))| {
                 let r = c * ch..c * ch + x.len();
-                let (f, t, m, i, rad, refp) = (
-                    &force[r.clone()],
-                    &torque[r.clone()],
-                    &mass[r.clone()],
-                    &inertia[r.clone()],
-                    &rad[r.clone()],
-                    &refp[r],
-                );
-                let mut worst = 0.0;
-                let mut l0 = 0;
-                while l0 + W <= x.len() {
-                    let lanes = l0..l0 + W;
-                    for l in lanes.clone() {
-                        kc[l].refresh(h, m[l], i[l]);
-                    }
-                    let e = Eight {
-                        x: (&mut x[lanes.clone()]).try_into().expect("8"),
-                        v: (&mut v[lanes.clone()]).try_into().expect("8"),
-                        a: (&mut a[lanes.clone()]).try_into().expect("8"),
-                        w: (&mut w[lanes.clone()]).try_into().expect("8"),
-                        st: (&mut st[lanes.clone()]).try_into().expect("8"),
-                        f: f[lanes.clone()].try_into().expect("8"),
-                        t: t[lanes.clone()].try_into().expect("8"),
-                        r: rad[lanes.clone()].try_into().expect("8"),
-                        m: m[lanes.clone()].try_into().expect("8"),
-                        refp: refp[lanes.clone()].try_into().expect("8"),
-                        hm: std::array::from_fn(|k| kc[l0 + k].hm),
-                        hi: std::array::from_fn(|k| kc[l0 + k].hi),
-                    };
-                    match dk.eight(e) {
-                        Some(d) => worst = nan_max(worst, d),
-                        None => break,
-                    }
-                    l0 += W;
-                }
-                for l in l0..x.len() {
-                    let kk = &mut kc[l];
-                    kk.refresh(h, m[l], i[l]);
-                    v[l] += f[l] * kk.hm;
-                    w[l] += t[l] * kk.hi;
-                    x[l] = dom.wrap(x[l] + v[l] * dt);
-                    a[l] += w[l] * dt;
-                    st[l] = CircleState {
-                        pos: x[l],
-                        vel: v[l],
-                        omega: w[l],
-                        r: rad[l],
-                        mass: m[l],
-                        pad: 0.0,
-                    };
-                    worst = nan_max(worst, dom.min_image(x[l] - refp[l]).norm2());
-                }
-                worst
+                simd::dispatch(KickChunk {
+                    dom: &dom,
+                    dk: &dk,
+                    h,
+                    dt,
+                    x,
+                    v,
+                    a,
+                    w,
+                    st,
+                    kc,
+                    f: &force[r.clone()],
+                    t: &torque[r.clone()],
+                    m: &mass[r.clone()],
+                    i: &inertia[r.clone()],
+                    rad: &rad[r.clone()],
+                    refp: &refp[r],
+                })
             })
             .reduce(|| 0.0, nan_max)
     }
@@ -149,5 +117,101 @@ impl Stepper {
                 }
             })
             .reduce(|| 0.0, nan_max)
+    }
+}
+
+/// One chunk of the all-disk kick and drift.
+struct KickChunk<'a> {
+    dom: &'a Domain,
+    dk: &'a DiskKick,
+    h: f64,
+    dt: f64,
+    x: &'a mut [Vec2],
+    v: &'a mut [Vec2],
+    a: &'a mut [f64],
+    w: &'a mut [f64],
+    st: &'a mut [CircleState],
+    kc: &'a mut [Kick],
+    f: &'a [Vec2],
+    t: &'a [f64],
+    m: &'a [f64],
+    i: &'a [f64],
+    rad: &'a [f64],
+    refp: &'a [Vec2],
+}
+
+impl WithSimd for KickChunk<'_> {
+    type Output = f64;
+    /// Eight disks at a time, then the scalar loop for the rest (and for a batch with a disk
+    /// that must take the far wrap).
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) -> f64 {
+        let KickChunk {
+            dom,
+            dk,
+            h,
+            dt,
+            x,
+            v,
+            a,
+            w,
+            st,
+            kc,
+            f,
+            t,
+            m,
+            i,
+            rad,
+            refp,
+        } = self;
+        let mut worst = 0.0;
+        let mut l0 = 0;
+        while l0 + W <= x.len() {
+            let lanes = l0..l0 + W;
+            let mut hm = [0.0; W];
+            let mut hi = [0.0; W];
+            for (k, kk) in kc[lanes.clone()].iter_mut().enumerate() {
+                kk.refresh(h, m[l0 + k], i[l0 + k]);
+                hm[k] = kk.hm;
+                hi[k] = kk.hi;
+            }
+            let e = Eight {
+                x: (&mut x[lanes.clone()]).try_into().expect("8"),
+                v: (&mut v[lanes.clone()]).try_into().expect("8"),
+                a: (&mut a[lanes.clone()]).try_into().expect("8"),
+                w: (&mut w[lanes.clone()]).try_into().expect("8"),
+                st: (&mut st[lanes.clone()]).try_into().expect("8"),
+                f: f[lanes.clone()].try_into().expect("8"),
+                t: t[lanes.clone()].try_into().expect("8"),
+                r: rad[lanes.clone()].try_into().expect("8"),
+                m: m[lanes.clone()].try_into().expect("8"),
+                refp: refp[lanes].try_into().expect("8"),
+                hm,
+                hi,
+            };
+            match dk.eight_in::<S>(e) {
+                Some(d) => worst = nan_max(worst, d),
+                None => break,
+            }
+            l0 += W;
+        }
+        for l in l0..x.len() {
+            let kk = &mut kc[l];
+            kk.refresh(h, m[l], i[l]);
+            v[l] += f[l] * kk.hm;
+            w[l] += t[l] * kk.hi;
+            x[l] = dom.wrap(x[l] + v[l] * dt);
+            a[l] += w[l] * dt;
+            st[l] = CircleState {
+                pos: x[l],
+                vel: v[l],
+                omega: w[l],
+                r: rad[l],
+                mass: m[l],
+                pad: 0.0,
+            };
+            worst = nan_max(worst, dom.min_image(x[l] - refp[l]).norm2());
+        }
+        worst
     }
 }

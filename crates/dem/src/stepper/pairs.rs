@@ -9,9 +9,10 @@ use crate::contact::{ContactInput, ContactLaw, History};
 use crate::domain::Domain;
 use crate::history::stride_of;
 use crate::pair_linear::LinearPair;
-use crate::scratch::{CircleState, PairOut};
+use crate::scratch::{CircleState, Kick, PairOut};
 use crate::system::System;
 use crate::vector::{Vec2, Vector};
+use lbdem_core::simd::{self, Simd, WithSimd};
 use rayon::prelude::*;
 
 /// The batched linear kernel for `law`, if it applies (see [`ContactLaw::linear`]).
@@ -23,6 +24,76 @@ pub(super) fn linear_kernel<L: ContactLaw>(law: &L, dom: &Domain, dt: f64) -> Op
     law.linear().and_then(|l| LinearPair::new(l, dom, dt))
 }
 
+/// A pair kernel: every pair of a slice, compiled into an op of `lbdem_core::simd::dispatch`
+/// at level `S` (so it must inline: `#[inline(always)]`).
+pub(super) trait PairKernel: Sync {
+    type H: Send;
+    fn run<S: Simd>(
+        &self,
+        cst: &[CircleState],
+        pairs: &[[u32; 2]],
+        hist: &mut [Self::H],
+        out: &mut [PairOut],
+        touch: &mut [u8],
+    );
+}
+
+impl PairKernel for LinearPair {
+    type H = History;
+    #[inline(always)]
+    fn run<S: Simd>(
+        &self,
+        cst: &[CircleState],
+        pairs: &[[u32; 2]],
+        hist: &mut [History],
+        out: &mut [PairOut],
+        touch: &mut [u8],
+    ) {
+        self.run_in::<S>(cst, pairs, hist, out, touch)
+    }
+}
+
+/// Any law through [`generic_pairs`].
+pub(super) struct Generic<'a, L> {
+    pub(super) law: &'a L,
+    pub(super) dom: Domain,
+    pub(super) dt: f64,
+}
+
+impl<L: ContactLaw> PairKernel for Generic<'_, L> {
+    type H = L::History;
+    #[inline(always)]
+    fn run<S: Simd>(
+        &self,
+        cst: &[CircleState],
+        pairs: &[[u32; 2]],
+        hist: &mut [L::History],
+        out: &mut [PairOut],
+        touch: &mut [u8],
+    ) {
+        generic_pairs(self.law, &self.dom, self.dt, cst, pairs, hist, out, touch)
+    }
+}
+
+/// One chunk of the pair pass.
+struct PairChunk<'a, K: PairKernel> {
+    kernel: &'a K,
+    cst: &'a [CircleState],
+    pairs: &'a [[u32; 2]],
+    hist: &'a mut [K::H],
+    out: &'a mut [PairOut],
+    touch: &'a mut [u8],
+}
+
+impl<K: PairKernel> WithSimd for PairChunk<'_, K> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        self.kernel
+            .run::<S>(self.cst, self.pairs, self.hist, self.out, self.touch)
+    }
+}
+
 impl Stepper {
     /// Every pair, in parallel over fixed chunks of pairs: force on i, torques on i and j.
     pub(super) fn pair_pass<L: ContactLaw>(&mut self, dt: f64, law: &L, sys: &mut System) {
@@ -32,23 +103,17 @@ impl Stepper {
         match linear_kernel(law, &dom, dt) {
             Some(k) => {
                 let hist = sys.contacts.hist.conform::<History>(n);
-                self.chunked(pairs, hist, |cst, pr, h, o, t| k.run(cst, pr, h, o, t));
+                self.chunked(pairs, hist, &k);
             }
             None => {
                 let hist = sys.contacts.hist.conform::<L::History>(n);
-                self.chunked(pairs, hist, |cst, pr, h, o, t| {
-                    generic_pairs(law, &dom, dt, cst, pr, h, o, t)
-                });
+                self.chunked(pairs, hist, &Generic { law, dom, dt });
             }
         }
     }
 
-    fn chunked<H: Send>(
-        &mut self,
-        pairs: &[[u32; 2]],
-        hist: &mut [H],
-        kernel: impl Fn(&[CircleState], &[[u32; 2]], &mut [H], &mut [PairOut], &mut [u8]) + Sync,
-    ) {
+    /// Each chunk of pairs is one op of `lbdem_core::simd::dispatch`.
+    fn chunked<K: PairKernel>(&mut self, pairs: &[[u32; 2]], hist: &mut [K::H], kernel: &K) {
         let n = pairs.len();
         let cst = &self.cstate;
         let ch = PAIR_CHUNK;
@@ -57,16 +122,23 @@ impl Stepper {
             .zip(hist.par_chunks_mut(ch))
             .zip(self.touch[..n].par_chunks_mut(ch))
             .zip(self.out[..n].par_chunks_mut(ch))
-            .for_each(|(((pairs, hist), touch), out)| kernel(cst, pairs, hist, out, touch));
+            .for_each(|(((pairs, hist), touch), out)| {
+                simd::dispatch(PairChunk {
+                    kernel,
+                    cst,
+                    pairs,
+                    hist,
+                    out,
+                    touch,
+                })
+            });
     }
 
     /// Per body: each circle's own records (as i, ascending j) plus its reactions (as j,
     /// ascending i), over its circles in order. With `fin` (nothing else adds to the contact
-    /// forces) the finish pass follows in the same pass.
+    /// forces) the finish pass follows in the same pass. Each chunk of bodies is one op of
+    /// `lbdem_core::simd::dispatch`.
     pub(super) fn gather(&mut self, sys: &mut System, fin: Option<&Finish>) {
-        let (out, ps, js, jl) = (&self.out, &self.pair_start, &self.j_start, &self.j_list);
-        let circle_sum = |c: usize| -> (Vec2, f64) { circle_sum(out, 0, ps, js, jl, c) };
-        let (disks, kick, carm) = (self.all_disks, &self.kick, &self.carm);
         let Bodies5 {
             force,
             torque,
@@ -78,40 +150,108 @@ impl Stepper {
             ext_torque,
             cstart,
         } = Bodies5::of(&mut sys.bodies);
+        let g = Gather {
+            out: &self.out,
+            ps: &self.pair_start,
+            js: &self.j_start,
+            jl: &self.j_list,
+            disks: self.all_disks,
+            kick: &self.kick,
+            carm: &self.carm,
+            fin,
+            mass,
+            inertia,
+            ext_force,
+            ext_torque,
+            cstart,
+        };
+        let ch = super::BODY_CHUNK;
         force
-            .par_iter_mut()
-            .zip(torque.par_iter_mut())
-            .zip(vel.par_iter_mut().zip(omega.par_iter_mut()))
+            .par_chunks_mut(ch)
+            .zip(torque.par_chunks_mut(ch))
+            .zip(vel.par_chunks_mut(ch).zip(omega.par_chunks_mut(ch)))
             .enumerate()
-            .with_min_len(512)
-            .for_each(|(k, ((f, t), (v, w)))| {
-                if disks {
-                    (*f, *t) = circle_sum(k);
-                } else {
-                    let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
-                    let c0 = cstart[k];
-                    for (c, arm) in (c0..).zip(&carm[c0..cstart[k + 1]]) {
-                        let (fc, tc) = circle_sum(c);
-                        fb += fc;
-                        tb += tc + arm.cross(fc);
-                    }
-                    *f = fb;
-                    *t = tb;
-                }
-                if let Some(fin) = fin {
-                    fin.apply(
-                        f,
-                        t,
-                        v,
-                        w,
-                        mass[k],
-                        inertia[k],
-                        &kick[k],
-                        ext_force[k],
-                        ext_torque[k],
-                    );
-                }
+            .for_each(|(c, ((f, t), (v, w)))| {
+                simd::dispatch(GatherChunk {
+                    g: &g,
+                    k0: c * ch,
+                    f,
+                    t,
+                    v,
+                    w,
+                })
             });
+    }
+}
+
+/// What the gather reads.
+struct Gather<'a> {
+    out: &'a [PairOut],
+    ps: &'a [u32],
+    js: &'a [u32],
+    jl: &'a [u32],
+    disks: bool,
+    kick: &'a [Kick],
+    carm: &'a [Vec2],
+    fin: Option<&'a Finish>,
+    mass: &'a [f64],
+    inertia: &'a [f64],
+    ext_force: &'a [Vec2],
+    ext_torque: &'a [f64],
+    cstart: &'a [usize],
+}
+
+/// The gather of bodies `k0..k0 + f.len()`.
+struct GatherChunk<'a, 'b> {
+    g: &'b Gather<'a>,
+    k0: usize,
+    f: &'b mut [Vec2],
+    t: &'b mut [f64],
+    v: &'b mut [Vec2],
+    w: &'b mut [f64],
+}
+
+impl WithSimd for GatherChunk<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, _: S) {
+        let g = self.g;
+        for (l, (((f, t), v), w)) in self
+            .f
+            .iter_mut()
+            .zip(self.t.iter_mut())
+            .zip(self.v.iter_mut())
+            .zip(self.w.iter_mut())
+            .enumerate()
+        {
+            let k = self.k0 + l;
+            if g.disks {
+                (*f, *t) = circle_sum(g.out, 0, g.ps, g.js, g.jl, k);
+            } else {
+                let (mut fb, mut tb) = (Vec2::ZERO, 0.0);
+                let c0 = g.cstart[k];
+                for (c, arm) in (c0..).zip(&g.carm[c0..g.cstart[k + 1]]) {
+                    let (fc, tc) = circle_sum(g.out, 0, g.ps, g.js, g.jl, c);
+                    fb += fc;
+                    tb += tc + arm.cross(fc);
+                }
+                *f = fb;
+                *t = tb;
+            }
+            if let Some(fin) = g.fin {
+                fin.apply(
+                    f,
+                    t,
+                    v,
+                    w,
+                    g.mass[k],
+                    g.inertia[k],
+                    &g.kick[k],
+                    g.ext_force[k],
+                    g.ext_torque[k],
+                );
+            }
+        }
     }
 }
 
@@ -144,6 +284,7 @@ pub(super) fn circle_sum(
 /// The pair pass for any law: force on i, torques on i and j, and whether the law acted (the
 /// pair overlaps, or its gap is below the law's range). Pairs out of range get a fresh history.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(super) fn generic_pairs<L: ContactLaw>(
     law: &L,
     dom: &Domain,
