@@ -35,6 +35,7 @@ lbdem-dem|shear_rheology|flow_curve_against_boyer_et_al|simple shear of 400 lubr
 EXPLORATIONS='
 lbdem-lbm|stability|explore_tau|
 lbdem-dem|shear_rheology|ci_case_against_smaller_step_and_stokes_number|
+lbdem-dem|extruder|explore_reduced_flow|
 '
 
 list_only=0
