@@ -29,12 +29,14 @@ lbdem-coupling|dkt_uhlmann|finer_lattices_converge_into_the_published_envelope|D
 lbdem|sweep_cli|mass_scaling_by_a_hundred_is_within_the_stated_tolerance_over_sixteen_assemblies|reduced shear cell on 16 random assemblies, mass_scale 100 (Simulation I'"'"'s switch) against 1: ε_vol^DEM, plate force, displacement profile|the unscaled runs, paired (issue 13 item 7)|mean shift + 2 SE: 0.0018, 21 %, 4.6 % of u_y (measured 0.0009, 10.7 %, 2.3 %)
 lbdem-coupling|dkt_uhlmann|finest_lattice_stays_in_the_published_envelope|DKT at 64 cells/d|Uhlmann 2005; Koblitz et al. 2017|inside the envelope (allowance: the publications'"'"' own difference)
 lbdem-dem|shear_rheology|flow_curve_against_boyer_et_al|simple shear of 400 lubricated bidisperse spheres (Ness et al. 2017 model, Lees-Edwards), φ = 0.40-0.55: stresses and μ = (−σ_xy + η γ̇)/σ_yy|Boyer, Guazzelli & Pouliquen 2011 μ(I_v), φ(I_v)|stresses rise with φ, μ falls loose → dense by > 2 SE; μ within 20 % at φ ≥ 0.53 (measured −8.6 %, +1.4 %)
+lbdem|lib|reduced_extruder_reaches_the_mass_balance|reduced Ness et al. 2017 extruder (barrel 16 d, die 8 d, case A paste) run to its mass balance|Ness et al. 2017 steady-state check: inserted and removed rates equal|imbalance <= 0.15 over a 30 t window with >= 100 grains out; die velocity > 0
 '
 # Ignored tests that are explorations (they print, they assert nothing): not validations.
 # shellcheck disable=SC2034
 EXPLORATIONS='
 lbdem-lbm|stability|explore_tau|
 lbdem-dem|shear_rheology|ci_case_against_smaller_step_and_stokes_number|
+lbdem-dem|extruder|explore_reduced_flow|
 '
 
 list_only=0

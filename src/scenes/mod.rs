@@ -12,6 +12,7 @@ pub mod observers;
 pub mod run;
 pub mod schema;
 pub mod snapshot;
+pub mod sphere_table;
 pub mod timeloop;
 
 #[cfg(test)]

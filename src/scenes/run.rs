@@ -2,7 +2,7 @@
 //! observers its `[run]` and `[output]` ask for, and hand both to the one time loop.
 
 use super::models;
-use super::observers::{Progress, Series, SlowerThan, Snapshots, Steady, WallClock, WallMoved};
+use super::observers::{MassBalanced, Progress, Series, SlowerThan, Snapshots, Steady, WallClock, WallMoved};
 use super::schema::{Loaded, Physics, Scene, TriggerSpec, WallRef};
 use super::timeloop::{self, LoopCfg, Model, Observer, Probe, Trigger};
 use crate::contract::Table;
@@ -26,6 +26,7 @@ pub fn model(l: &Loaded, resume: bool) -> Result<Box<dyn Model>> {
         Physics::Fluid => models::fluid::build(&l.scene, &l.base_dir)?,
         Physics::Coupled => models::coupled::build(&l.scene, &l.base_dir)
             .with_context(|| format!("scene {} refused", l.path.display()))?,
+        Physics::Extruder => Box::new(models::extruder::Extruder::build(&l.scene)?),
     })
 }
 
@@ -101,6 +102,11 @@ pub fn observers(s: &Scene, total: u64) -> Result<(Vec<Box<dyn Observer>>, Trigg
             tol,
             trigger: series.clone(),
             last: None,
+        }));
+    }
+    if s.extruder.as_ref().is_some_and(|e| e.stop_when_steady) {
+        obs.push(Box::new(MassBalanced {
+            trigger: series.clone(),
         }));
     }
     if let Some(w) = &r.until_wall_moved {

@@ -69,6 +69,7 @@ fn shipped(name: &str) -> String {
 mod bad_input;
 mod coupled;
 mod dry;
+mod extruder;
 mod float;
 mod fluid;
 mod initial;

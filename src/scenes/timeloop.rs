@@ -61,6 +61,8 @@ pub enum Probe {
     WallDisplacement(usize),
     /// Mean liquid speed (m/s).
     MeanLiquidSpeed,
+    /// Since when an extruder's mass balance has held (s), if it holds now.
+    SteadySince,
 }
 
 /// When an observer acts, in steps (a `count` or `at` of the scene file is turned into these

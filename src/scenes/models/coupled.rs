@@ -382,6 +382,7 @@ impl<T: Real> Model for CoupledModel<T> {
                 Some((wall_anchor(w) - self.wall_start[k]).norm())
             }
             Probe::MeanLiquidSpeed => Some(self.liquid_speeds().0),
+            Probe::SteadySince => None,
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {

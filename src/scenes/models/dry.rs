@@ -165,7 +165,7 @@ impl Model for Dry {
                 let w = self.sys.walls.get(k)?;
                 Some((wall_anchor(w) - self.wall_start[k]).norm())
             }
-            Probe::MeanLiquidSpeed => None,
+            Probe::MeanLiquidSpeed | Probe::SteadySince => None,
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {

@@ -5,6 +5,7 @@
 
 pub mod coupled;
 pub mod dry;
+pub mod extruder;
 pub mod fluid;
 pub mod packed_zone;
 pub mod shear_cell;

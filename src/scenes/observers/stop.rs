@@ -128,3 +128,28 @@ impl Observer for WallClock {
         })
     }
 }
+
+/// Stop when an extruder's mass balance holds (`[extruder] stop_when_steady`): the insertion
+/// and removal rates over the trailing window agree within the tolerance (Ness et al. 2017's
+/// steady-state check; `lbdem_dem::spheres::extruder::balance`).
+pub struct MassBalanced {
+    pub trigger: Trigger,
+}
+
+impl Observer for MassBalanced {
+    fn name(&self) -> &'static str {
+        "stop_when_steady"
+    }
+    fn trigger(&self) -> &Trigger {
+        &self.trigger
+    }
+    fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
+        Ok(match m.probe(Probe::SteadySince) {
+            Some(t) => Flow::Stop(format!(
+                "steady: the mass balance has held since t = {t:e} s (step {})",
+                m.steps_done()
+            )),
+            None => Flow::Continue,
+        })
+    }
+}

@@ -105,6 +105,84 @@ const LAW_RULES: &[Rule] = &[
 const RULES: &[Rule] = &[
     Rule("domain.lo", Need::Len(0), ""),
     Rule(
+        "extruder.barrel_width",
+        Need::Positive,
+        "barrel width (m; Ness: 100 d)",
+    ),
+    Rule(
+        "extruder.barrel_length",
+        Need::Positive,
+        "ram face to die entry (m; Ness: 300 d)",
+    ),
+    Rule("extruder.die_width", Need::Positive, "die width (m; Ness: 20 d)"),
+    Rule("extruder.die_length", Need::Positive, "die length (m)"),
+    Rule("extruder.depth", Need::Positive, "periodic depth (m; Ness: 5 d)"),
+    Rule(
+        "extruder.inlet_length",
+        Need::Positive,
+        "inlet box length (m; about 10 d)",
+    ),
+    Rule(
+        "extruder.wall_diameter",
+        Need::Positive,
+        "wall-grain diameter (m; Ness: 0.5 d)",
+    ),
+    Rule("extruder.wall_spacing", Need::Positive, "wall-grain spacing (m)"),
+    Rule(
+        "extruder.body_force",
+        Need::Positive,
+        "body force per inlet grain (N)",
+    ),
+    Rule(
+        "extruder.phi_inlet",
+        Need::Between(0.0, 0.64),
+        "inlet volume fraction (Ness: 0.5)",
+    ),
+    Rule(
+        "extruder.steady_window",
+        Need::Positive,
+        "mass-balance window (s)",
+    ),
+    Rule(
+        "extruder.steady_tolerance",
+        Need::Between(0.0, 1.0),
+        "relative rate difference (0.1)",
+    ),
+    Rule(
+        "extruder.outlet_gap",
+        Need::NonNegative,
+        "removal distance past the die (m)",
+    ),
+    Rule(
+        "suspension.diameters",
+        Need::Len(2),
+        "paste diameters [d, 1.5 d] (m)",
+    ),
+    Rule("suspension.diameters.*", Need::Positive, "paste diameter (m)"),
+    Rule(
+        "suspension.density",
+        Need::Positive,
+        "grain and liquid density (kg/m³)",
+    ),
+    Rule(
+        "suspension.viscosity",
+        Need::Positive,
+        "liquid viscosity η_f (Pa s)",
+    ),
+    Rule("suspension.k_n", Need::Positive, "normal stiffness (N/m)"),
+    Rule(
+        "suspension.mu_p",
+        Need::NonNegative,
+        "particle-particle friction (Ness: 0.1 or 1)",
+    ),
+    Rule(
+        "suspension.mu_w",
+        Need::NonNegative,
+        "particle-wall friction (Ness: 0 or 0.1)",
+    ),
+    Rule("suspension.dt", Need::Positive, "time step (s)"),
+    Rule("suspension.skin", Need::NonNegative, "Verlet skin (m)"),
+    Rule(
         "particles.density",
         Need::Positive,
         "density (kg/m² = ρ_S × depth)",

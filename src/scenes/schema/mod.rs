@@ -11,6 +11,7 @@
 mod check;
 mod coupling;
 mod dem;
+mod extruder;
 mod fluid;
 mod legacy;
 mod packed_zone;
@@ -23,6 +24,7 @@ pub use dem::{
     BondsSection, CompressSection, DemSection, GenerateSection, MembraneSection, ParticlesSection,
     TemplateSection, WallSection,
 };
+pub use extruder::{ExtruderSection, NessLaw, SuspensionSection};
 pub use fluid::{
     BoundariesSection, FaceSection, FluidSection, ForcingSection, LatticeSection, MaskSection,
     ObstacleSection,
@@ -62,8 +64,8 @@ pub struct Header {
 }
 
 /// `[domain]`: the box (m), 2 or 3 entries per key, and which axes are periodic (for the grains
-/// and the lattice alike).
-#[derive(Clone, Debug, Deserialize, Serialize)]
+/// and the lattice alike). An `[extruder]` scene has none (its box follows from its geometry).
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DomainSection {
     pub lo: Vec<f64>,
@@ -101,6 +103,7 @@ impl DomainSection {
 pub struct Scene {
     #[serde(default)]
     pub scene: Header,
+    #[serde(default)]
     pub domain: DomainSection,
     #[serde(default)]
     pub particles: Option<ParticlesSection>,
@@ -136,6 +139,11 @@ pub struct Scene {
     pub mask: Option<MaskSection>,
     #[serde(default)]
     pub coupling: Option<CouplingSection>,
+    /// Ness et al. (2017)'s extruder (3D spheres): a scene of its own kind of grains.
+    #[serde(default)]
+    pub extruder: Option<ExtruderSection>,
+    #[serde(default)]
+    pub suspension: Option<SuspensionSection>,
     pub run: RunSection,
     #[serde(default)]
     pub output: OutputSection,
@@ -151,6 +159,8 @@ pub enum Physics {
     Fluid,
     /// Grains in a liquid (LBM-DEM).
     Coupled,
+    /// Ness et al. (2017)'s extruder: 3D lubricated spheres ([extruder], [suspension]).
+    Extruder,
 }
 
 #[derive(Debug)]
@@ -325,6 +335,14 @@ fn suggestion(msg: &str) -> Option<(String, String)> {
 impl Scene {
     /// What the scene simulates, checking that every section it has is used by that physics.
     pub fn physics(&self) -> Result<Physics> {
+        if self.extruder.is_some() {
+            return self.extruder_physics();
+        }
+        if self.suspension.is_some() {
+            bail!(
+                "[suspension] is given but the scene has no [extruder]; add [extruder] or remove [suspension]"
+            );
+        }
         let d = &self.domain;
         if !(d.lo.len() == 2 || d.lo.len() == 3) || d.hi.len() != d.lo.len() {
             bail!(
@@ -429,6 +447,64 @@ impl Scene {
         if self.bonds.is_some() && self.membrane.is_none() {
             bail!("[bonds] bond the membrane grains: add a [membrane] section");
         }
+        self.check_run(grains, liquid)?;
+        Ok(physics)
+    }
+
+    /// An `[extruder]` scene: 3D spheres with their own box, so none of the 2D engine's or the
+    /// liquid's sections.
+    fn extruder_physics(&self) -> Result<Physics> {
+        let others: [(&str, bool); 18] = [
+            (
+                "[domain]",
+                !self.domain.lo.is_empty() || !self.domain.hi.is_empty(),
+            ),
+            ("[particles]", self.particles.is_some()),
+            ("[contact]", self.contact.is_some()),
+            ("[wall_contact]", self.wall_contact.is_some()),
+            ("[[walls]]", !self.walls.is_empty()),
+            ("[bonds]", self.bonds.is_some()),
+            ("[membrane]", self.membrane.is_some()),
+            ("[dem]", self.dem.is_some()),
+            ("[compress]", self.compress.is_some()),
+            ("[shear_cell]", self.shear_cell.is_some()),
+            ("[packed_zone]", self.packed_zone.is_some()),
+            ("[fluid]", self.fluid.is_some()),
+            ("[lattice]", self.lattice.is_some()),
+            ("[boundaries]", self.boundaries.is_some()),
+            ("[forcing]", self.forcing.is_some()),
+            ("[[obstacles]]", !self.obstacles.is_empty()),
+            ("[mask]", self.mask.is_some()),
+            ("[coupling]", self.coupling.is_some()),
+        ];
+        if let Some((s, _)) = others.iter().find(|(_, on)| *on) {
+            bail!(
+                "{s} is given in an [extruder] scene, which builds its own box and 3D grains \
+                 ([extruder] and [suspension]); remove {s}"
+            );
+        }
+        let (Some(e), Some(s)) = (&self.extruder, &self.suspension) else {
+            bail!("[extruder] needs a [suspension] section (diameters, density, viscosity, k_n, mu_p, mu_w)");
+        };
+        let r = &self.run;
+        if r.until_slower_than.is_some() || r.until_wall_moved.is_some() || r.until_steady.is_some() {
+            bail!(
+                "[run] until_slower_than / until_wall_moved / until_steady are for 2D scenes; an extruder \
+                 stops at its mass balance with [extruder] stop_when_steady = true"
+            );
+        }
+        if self.output.series.when.is_some() || self.output.snapshots.when.is_some() {
+            bail!(
+                "[output] when = {{...}} triggers read 2D quantities; use every, count or at in an extruder scene"
+            );
+        }
+        extruder::check(e, s)?;
+        self.check_run(true, false)?;
+        Ok(Physics::Extruder)
+    }
+
+    /// The `[run]` length and the `[output]` triggers.
+    fn check_run(&self, grains: bool, liquid: bool) -> Result<()> {
         match (self.run.steps, self.run.time) {
             (Some(0), _) => bail!("[run] steps = 0: give at least 1"),
             (Some(_), None) => {}
@@ -475,7 +551,7 @@ impl Scene {
                 "[output]: wall_seconds is for checkpoints only (series and snapshots must not depend on the machine's speed)"
             );
         }
-        Ok(physics)
+        Ok(())
     }
 }
 

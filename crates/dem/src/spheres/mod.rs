@@ -29,6 +29,7 @@ pub mod clump;
 pub mod domain;
 pub mod edit;
 pub mod error;
+pub mod extruder;
 pub mod hook;
 pub mod law;
 pub mod stepper;
