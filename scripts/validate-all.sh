@@ -28,6 +28,7 @@ lbdem-coupling|dkt_uhlmann|coarser_lattice_and_the_variants|DKT at 16 cells/d; w
 lbdem-coupling|dkt_uhlmann|finer_lattices_converge_into_the_published_envelope|DKT at 32 and 48 cells/d|Uhlmann 2005; Koblitz et al. 2017|as above, and inside the envelope at 48 (allowance: the publications'"'"' own difference)
 lbdem|sweep_cli|mass_scaling_by_a_hundred_is_within_the_stated_tolerance_over_sixteen_assemblies|reduced shear cell on 16 random assemblies, mass_scale 100 (Simulation I'"'"'s switch) against 1: ε_vol^DEM, plate force, displacement profile|the unscaled runs, paired (issue 13 item 7)|mean shift + 2 SE: 0.0018, 21 %, 4.6 % of u_y (measured 0.0009, 10.7 %, 2.3 %)
 lbdem-coupling|dkt_uhlmann|finest_lattice_stays_in_the_published_envelope|DKT at 64 cells/d|Uhlmann 2005; Koblitz et al. 2017|inside the envelope (allowance: the publications'"'"' own difference)
+lbdem-lbm|free_surface|dam_break_front_matches_martin_moyce_fine|2D dam break, column a = 64 nodes, front Z = x/a at the 13 digitised times T ≤ 8.03, no time shift|Martin & Moyce 1952 (REFERENCES.md)|15 % (measured +11.3 % at T = 1.22, −9.3 % at T = 8.03)
 lbdem-dem|shear_rheology|flow_curve_against_boyer_et_al|simple shear of 400 lubricated bidisperse spheres (Ness et al. 2017 model, Lees-Edwards), φ = 0.40-0.55: stresses and μ = (−σ_xy + η γ̇)/σ_yy|Boyer, Guazzelli & Pouliquen 2011 μ(I_v), φ(I_v)|stresses rise with φ, μ falls loose → dense by > 2 SE; μ within 20 % at φ ≥ 0.53 (measured −8.6 %, +1.4 %)
 '
 # Ignored tests that are explorations (they print, they assert nothing): not validations.
