@@ -5,7 +5,8 @@
 //! in f32 or f64 ([`kernel`]), halfway bounce-back on stationary and moving walls with the
 //! momentum-exchange force and torque, Zou-He velocity and pressure faces, periodic faces, and a
 //! stepper that stops at the first node leaving the accepted range with a diagnosis ([`stepper`]),
-//! and Bingham plastic rheology by a local relaxation time in the same kernels ([`bingham`]).
+//! Bingham plastic rheology by a local relaxation time in the same kernels ([`bingham`]), and a
+//! free surface by mass tracking ([`free_surface`]).
 //! Pure computation: no file I/O; units are converted in `lbdem_core::units::lattice`.
 
 // Kernels index several parallel arrays (velocities, weights, populations) by direction: an index
@@ -17,6 +18,7 @@ pub mod cases;
 pub mod collision;
 pub mod diagnosis;
 pub mod domain;
+pub mod free_surface;
 pub mod kernel;
 pub mod kernel_aa;
 pub mod lattice;
@@ -32,6 +34,7 @@ pub use bingham::{Bingham, BinghamRates};
 pub use collision::{Collider, Collision, LocalRates, NodeRates};
 pub use diagnosis::BadNode;
 pub use domain::{Domain, Face, Motion};
+pub use free_surface::{FreeSurface, FreeSurfaceParams, FreeSurfaceStepper};
 pub use kernel::Limits;
 pub use lattice::{D2Q9, D3Q19, Lattice};
 pub use real::Real;
@@ -65,6 +68,8 @@ pub enum LbmError {
     },
     #[error("TRT magic parameter = {magic} must be > 0; use 0.25 (stability) or 3/16 (exact walls)")]
     Magic { magic: f64 },
+    #[error("free surface: {0}")]
+    FreeSurface(String),
     #[error("unsupported set-up: {0}")]
     Unsupported(String),
     #[error(

@@ -1,0 +1,253 @@
+//! The free-surface step (Leonardi et al. 2014 Sect. 5.2): per node, gather the populations
+//! (pull streaming; bounce-back at walls, Eq. 26 from gas), add up the mass exchange of Eqs.
+//! 24-25, collide (any [`Collider`]: BGK, TRT, or the Bingham collider with its local τ) with
+//! gravity as a Guo body force (Leonardi Eqs. 15-17); then convert the interface nodes whose
+//! mass left the band ([`convert`]).
+//!
+//! Each node writes only its own populations, mass and moments and reads only the previous state
+//! (a gather, not a scatter), so the sweep is independent of the order nodes are visited in; it
+//! runs sequentially here (the cases of this module are small) and the conversions run
+//! sequentially in node order, so a run is deterministic.
+
+use super::cells::{FreeSurface, GAS, INTERFACE, LIQUID, WALL};
+use super::convert::{Conversions, ConvertScratch, convert};
+use super::mass::{link_exchange, link_weight};
+use super::reconstruct::{atmosphere, from_gas};
+use crate::LbmError;
+use crate::bingham::{Bingham, BinghamRates};
+use crate::collision::{CollideParams, Collider};
+use crate::diagnosis::BadNode;
+use crate::domain::Face;
+use crate::lattice::{Lattice, QMAX};
+use crate::plan::{Upstream, neighbour};
+use crate::stepper::Settings;
+use std::marker::PhantomData;
+
+/// No neighbour (across a wall face) in the link table.
+pub const NONE: u32 = u32::MAX;
+
+/// Parameters of the free surface.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FreeSurfaceParams {
+    /// Atmospheric density ρ_A of Eq. 26 (the gas pressure is c_s² ρ_A): 1, the reference
+    /// density of the liquid, so that the pressure is hydrostatic relative to the gas.
+    pub rho_atm: f64,
+    /// Conversion margin κ (module `convert`): interface nodes fill at m > (1 + κ)ρ and empty
+    /// at m < −κρ. Körner et al. (2005) use 1e-3.
+    pub kappa: f64,
+}
+
+impl Default for FreeSurfaceParams {
+    fn default() -> Self {
+        Self {
+            rho_atm: 1.0,
+            kappa: 1e-3,
+        }
+    }
+}
+
+/// Scratch and the step loop of a free-surface run.
+pub struct FreeSurfaceStepper<L: Lattice> {
+    settings: Settings,
+    params: FreeSurfaceParams,
+    coll: CollideParams<f64>,
+    bingham: Option<BinghamRates<f64>>,
+    /// x + c_i of every node, `links[i * n + x]`, [`NONE`] across a wall face.
+    links: Vec<u32>,
+    f_new: Vec<f64>,
+    mass_new: Vec<f64>,
+    rho_new: Vec<f64>,
+    u_new: Vec<[f64; 3]>,
+    scratch: ConvertScratch,
+    _l: PhantomData<L>,
+}
+
+impl<L: Lattice> FreeSurfaceStepper<L> {
+    /// Check the settings and the box. Faces must be periodic or stationary walls (moving walls
+    /// and Zou-He faces are not done with a free surface); solid nodes are stationary walls.
+    pub fn new(s: &FreeSurface<L>, settings: Settings, params: FreeSurfaceParams) -> Result<Self, LbmError> {
+        let coll = CollideParams::<f64>::new(&settings.collision, settings.force)?;
+        if !(params.rho_atm.is_finite() && params.rho_atm > 0.0) {
+            return Err(LbmError::FreeSurface(format!(
+                "atmospheric density rho_atm = {} must be finite and > 0 (Leonardi et al. 2014 Eq. 26); \
+                 use 1, the reference density",
+                params.rho_atm
+            )));
+        }
+        if !(params.kappa.is_finite() && (0.0..0.1).contains(&params.kappa)) {
+            return Err(LbmError::FreeSurface(format!(
+                "conversion margin kappa = {} must be in [0, 0.1); Körner et al. (2005) use 1e-3",
+                params.kappa
+            )));
+        }
+        let dom = &s.domain;
+        if (L::D == 2) != (dom.n[2] == 1) {
+            return Err(LbmError::Unsupported(format!(
+                "lattice {} on a box of {:?} nodes: use nz = 1 with D2Q9 and nz > 1 with D3Q19",
+                L::NAME,
+                dom.n
+            )));
+        }
+        for (k, fc) in dom.faces.iter().enumerate() {
+            let ok = match fc {
+                Face::Periodic => dom.faces[k ^ 1].is_periodic(),
+                Face::Wall { velocity } => {
+                    velocity.iter().all(|&v| v == 0.0) && !dom.faces[k ^ 1].is_periodic()
+                }
+                _ => false,
+            };
+            if !ok {
+                return Err(LbmError::Unsupported(format!(
+                    "face {k} is {fc:?} (opposite {:?}): a free-surface run takes periodic pairs or \
+                     stationary walls only",
+                    dom.faces[k ^ 1]
+                )));
+            }
+        }
+        let n = s.nodes();
+        let mut links = vec![NONE; L::Q * n];
+        for x in 0..n {
+            let p = dom.coords(x);
+            for i in 0..L::Q {
+                if let Upstream::Node(j) = neighbour(dom, p, L::C[i]) {
+                    links[i * n + x] = j as u32;
+                }
+            }
+        }
+        Ok(Self {
+            settings,
+            params,
+            coll,
+            bingham: None,
+            links,
+            f_new: vec![0.0; s.f.len()],
+            mass_new: vec![0.0; n],
+            rho_new: vec![0.0; n],
+            u_new: vec![[0.0; 3]; n],
+            scratch: ConvertScratch::default(),
+            _l: PhantomData,
+        })
+    }
+
+    /// Bingham plastic rheology (local τ per node, `bingham`) from the next step on, or the
+    /// settings' uniform τ (`None`).
+    pub fn set_bingham(&mut self, bingham: Option<Bingham>) -> Result<(), LbmError> {
+        self.bingham = match bingham {
+            Some(b) => Some(BinghamRates::new(
+                &b,
+                &self.settings.collision,
+                self.settings.force,
+            )?),
+            None => None,
+        };
+        Ok(())
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    pub fn params(&self) -> &FreeSurfaceParams {
+        &self.params
+    }
+
+    /// The link table: x + c_i at `links()[i * n + x]`, [`NONE`] across a wall face.
+    pub fn links(&self) -> &[u32] {
+        &self.links
+    }
+
+    /// Advance one step; the conversions it made. Stops with a diagnosis at the first liquid or
+    /// interface node outside `settings.limits`.
+    pub fn step(&mut self, s: &mut FreeSurface<L>) -> Result<Conversions, LbmError> {
+        let forced = self.settings.force.iter().any(|&v| v != 0.0);
+        let bad = match (self.bingham, forced) {
+            (Some(b), true) => self.sweep::<_, true>(s, &b),
+            (Some(b), false) => self.sweep::<_, false>(s, &b),
+            (None, true) => self.sweep::<_, true>(s, &self.coll.clone()),
+            (None, false) => self.sweep::<_, false>(s, &self.coll.clone()),
+        };
+        std::mem::swap(&mut s.f, &mut self.f_new);
+        std::mem::swap(&mut s.mass, &mut self.mass_new);
+        std::mem::swap(&mut s.rho, &mut self.rho_new);
+        std::mem::swap(&mut s.u, &mut self.u_new);
+        s.step += 1;
+        if let Some(x) = bad {
+            let tau = match &self.bingham {
+                Some(b) => 1.0 / b.omega_hi,
+                None => self.settings.collision.tau(),
+            };
+            return Err(BadNode {
+                step: s.step,
+                node: s.domain.coords(x),
+                rho: s.rho[x],
+                u: s.u[x],
+                tau,
+            }
+            .into_error(&self.settings.limits));
+        }
+        Ok(convert(s, &self.links, self.params.kappa, &mut self.scratch))
+    }
+
+    /// Stream, exchange mass and collide every liquid and interface node into the `*_new`
+    /// arrays; the first node outside the limits, if any.
+    fn sweep<C: Collider<L, f64>, const F: bool>(&mut self, s: &FreeSurface<L>, coll: &C) -> Option<usize> {
+        let n = s.nodes();
+        let limits = self.settings.limits;
+        let mut bad = None;
+        for x in 0..n {
+            let kind = s.cell[x];
+            if kind != LIQUID && kind != INTERFACE {
+                self.mass_new[x] = 0.0;
+                self.rho_new[x] = s.rho[x];
+                self.u_new[x] = s.u[x];
+                continue;
+            }
+            let fill_x = s.fill(x);
+            let atm = if kind == INTERFACE {
+                atmosphere::<L>(self.params.rho_atm, s.u[x])
+            } else {
+                [0.0; QMAX]
+            };
+            let mut f = [[0.0f64; 1]; QMAX];
+            f[0][0] = s.f[x];
+            let mut dm = 0.0;
+            for i in 1..L::Q {
+                let o = L::OPP[i];
+                // upstream node x − c_i = x + c_ī, and the population x sends to it
+                let up = self.links[o * n + x];
+                let f_out = s.f[o * n + x];
+                f[i][0] = if up == NONE {
+                    f_out
+                } else {
+                    let up = up as usize;
+                    match s.cell[up] {
+                        WALL => f_out,
+                        GAS => from_gas::<L>(&atm, i, f_out),
+                        k => {
+                            let f_in = s.f[i * n + up];
+                            dm += link_exchange(link_weight(kind, fill_x, k, s.fill(up)), f_in, f_out);
+                            f_in
+                        }
+                    }
+                };
+            }
+            let m = coll.collide::<1, F>(&mut f, x);
+            for i in 0..L::Q {
+                self.f_new[i * n + x] = f[i][0];
+            }
+            let (rho, u) = (m.rho[0], [m.u[0][0], m.u[1][0], m.u[2][0]]);
+            self.rho_new[x] = rho;
+            self.u_new[x] = u;
+            self.mass_new[x] = s.mass[x] + dm;
+            if bad.is_none() && !limits.accepts(rho, u) {
+                bad = Some(x);
+            }
+        }
+        bad
+    }
+}
+
+/// True when no liquid node touches a gas node (the interface is closed).
+pub fn is_closed<L: Lattice>(s: &FreeSurface<L>) -> bool {
+    s.open_interface().is_none()
+}
