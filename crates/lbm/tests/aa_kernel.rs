@@ -5,43 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 mod common;
 use common::*;
-use lbdem_lbm::{
-    Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, Motion, Partition, Real, Stepper, StepperAa,
-};
-
-fn setup<L: Lattice, T: Real>(n: [usize; 3]) -> Fluid<L, T> {
-    let lid = Face::Wall {
-        velocity: [0.02, 0.0, 0.0],
-    };
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let mut dom = Domain::new(
-        n,
-        [
-            Face::Periodic,
-            Face::Periodic,
-            wall,
-            lid,
-            Face::Periodic,
-            Face::Periodic,
-        ],
-    );
-    let c = [
-        n[0] as f64 / 3.0,
-        n[1] as f64 / 2.0,
-        if n[2] > 1 { n[2] as f64 / 2.0 } else { 0.0 },
-    ];
-    dom.fill_sphere(0, c, n[1] as f64 / 5.0);
-    let mut fl = Fluid::<L, T>::new(
-        dom,
-        vec![Motion {
-            centre: c,
-            velocity: [0.0, 0.005, 0.0],
-            omega: [0.0, 0.0, 2e-3],
-        }],
-    );
-    fl.init_equilibrium(|p| (1.0 + 1e-3 * ((p[0] * 3 + p[1]) % 5) as f64, [0.01, 0.0, 0.0]));
-    fl
-}
+use lbdem_lbm::{Collision, D2Q9, D3Q19, Lattice, Partition, Real, Stepper, StepperAa};
 
 fn compare<L: Lattice, T: Real>(n: [usize; 3], steps: usize) {
     let trt = Collision::Trt {
@@ -55,7 +19,7 @@ fn compare<L: Lattice, T: Real>(n: [usize; 3], steps: usize) {
 /// larger padded grids, where a small cancelling component carries the f32 round-off of |F|).
 fn compare_with<L: Lattice, T: Real>(n: [usize; 3], steps: usize, collision: Collision, norm_scale: bool) {
     let s = settings(collision, [1e-5, 0.0, 0.0]);
-    let mut a = setup::<L, T>(n);
+    let mut a = busy_fluid::<L, T>(n);
     let mut b = a.clone();
     let mut two = Stepper::new(&a, s).unwrap();
     let mut aa = StepperAa::new(&mut b, s).unwrap();
@@ -122,7 +86,7 @@ fn aa_identical_for_one_and_two_threads() {
             .build()
             .unwrap();
         pool.install(|| {
-            let mut fl = setup::<D2Q9, f64>([64, 48, 1]);
+            let mut fl = busy_fluid::<D2Q9, f64>([64, 48, 1]);
             let s = settings(Collision::Bgk { tau: 0.6 }, [1e-5, 0.0, 0.0]);
             let mut aa = StepperAa::new(&mut fl, s).unwrap();
             aa.partition = partition;
