@@ -1,10 +1,13 @@
 //! Velocity sets: D2Q9 (Su et al. 2020 Eq. 8) and D3Q19 (Leonardi et al. 2014 Eq. 14) behind
 //! one trait of constants, so that every kernel is written once and monomorphised per lattice.
 
+use crate::compiled::Compiled;
+
 /// A discrete velocity set. Directions come in opposite pairs: `C[OPP[i]] == -C[i]`, direction 0
 /// is the rest population, and `HALF` lists one direction of every moving pair (used by the TRT
 /// split into symmetric and antisymmetric parts).
-pub trait Lattice: Copy + Send + Sync + Default + 'static {
+/// [`Compiled`] holds the concrete steps of each lattice (compiled in this crate).
+pub trait Lattice: Compiled + Copy + Send + Sync + Default + 'static {
     const NAME: &'static str;
     /// Spatial dimension (2 or 3).
     const D: usize;

@@ -16,6 +16,7 @@
 pub mod bingham;
 pub mod cases;
 pub mod collision;
+pub mod compiled;
 pub mod diagnosis;
 pub mod domain;
 pub mod free_surface;

@@ -1,5 +1,9 @@
 //! Storage precision of the populations, chosen per run (f64 by default, f32 for speed).
 
+use crate::LbmError;
+use crate::lattice::Lattice;
+use crate::stepper::{Fluid, Macro, Stepper};
+use crate::stepper_aa::StepperAa;
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 /// Floating-point type the populations are stored and updated in.
@@ -36,6 +40,18 @@ pub trait Real:
     fn bad_block<const B: usize>(rho: &[Self; B], usq: &[Self; B], lo: Self, hi: Self, um: Self) -> u32 {
         bad_scalar(rho, usq, lo, hi, um)
     }
+    /// One two-array step: the lattice's compiled step of this precision (`compiled`).
+    fn step_two<L: Lattice>(
+        st: &mut Stepper<L, Self>,
+        fluid: &mut Fluid<L, Self>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError>;
+    /// One AA step: the lattice's compiled step of this precision (`compiled`).
+    fn step_aa<L: Lattice>(
+        st: &mut StepperAa<L, Self>,
+        fluid: &mut Fluid<L, Self>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError>;
 }
 
 /// Mask of the low `b` bits (b <= 32).
@@ -57,6 +73,22 @@ pub fn bad_scalar<T: Real, const B: usize>(rho: &[T; B], usq: &[T; B], lo: T, hi
 
 impl Real for f64 {
     const NAME: &'static str = "f64";
+    #[inline(always)]
+    fn step_two<L: Lattice>(
+        st: &mut Stepper<L, Self>,
+        fluid: &mut Fluid<L, Self>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError> {
+        L::step_two_f64(st, fluid, out)
+    }
+    #[inline(always)]
+    fn step_aa<L: Lattice>(
+        st: &mut StepperAa<L, Self>,
+        fluid: &mut Fluid<L, Self>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError> {
+        L::step_aa_f64(st, fluid, out)
+    }
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
         x
@@ -86,6 +118,22 @@ impl Real for f64 {
 
 impl Real for f32 {
     const NAME: &'static str = "f32";
+    #[inline(always)]
+    fn step_two<L: Lattice>(
+        st: &mut Stepper<L, Self>,
+        fluid: &mut Fluid<L, Self>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError> {
+        L::step_two_f32(st, fluid, out)
+    }
+    #[inline(always)]
+    fn step_aa<L: Lattice>(
+        st: &mut StepperAa<L, Self>,
+        fluid: &mut Fluid<L, Self>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError> {
+        L::step_aa_f32(st, fluid, out)
+    }
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
         x as f32

@@ -28,7 +28,7 @@ pub struct ForceTorque {
 /// stepping the restored copy continues the run bit for bit.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 #[serde(bound = "")]
-pub struct Fluid<L: Lattice, T: Real> {
+pub struct Fluid<L, T: Real> {
     pub domain: Domain,
     /// Post-collision populations of the current time, `f[i * n + node]`.
     pub f: Vec<T>,
@@ -104,7 +104,7 @@ pub struct Settings {
 }
 
 /// Scratch and the step loop.
-pub struct Stepper<L: Lattice, T: Real> {
+pub struct Stepper<L, T: Real> {
     settings: Settings,
     params: CollideParams<T>,
     /// Per-node rates (`set_local_tau`) and the τ they came from (diagnosis).
@@ -342,8 +342,18 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
     }
 
     /// Advance one step on the current rayon pool. Forces on obstacles and walls are left in
-    /// `self.forces`; if `out` is given it receives ρ and u of every fluid node.
+    /// `self.forces`; if `out` is given it receives ρ and u of every fluid node. (The kernels are
+    /// compiled in this crate: `compiled`.)
     pub fn step(&mut self, fluid: &mut Fluid<L, T>, out: Option<&mut Macro>) -> Result<(), LbmError> {
+        T::step_two(self, fluid, out)
+    }
+
+    /// The body of [`Stepper::step`], instantiated by `compiled` only.
+    pub(crate) fn step_generic(
+        &mut self,
+        fluid: &mut Fluid<L, T>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError> {
         self.exchange_forces(fluid);
         let n = fluid.nodes();
         self.motions.clear();

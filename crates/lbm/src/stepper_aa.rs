@@ -32,7 +32,7 @@ pub enum Partition {
     Contiguous,
 }
 
-pub struct StepperAa<L: Lattice, T: Real> {
+pub struct StepperAa<L, T: Real> {
     settings: Settings,
     params: CollideParams<T>,
     /// Per-node rates (`set_local_tau`) and the τ they came from (diagnosis).
@@ -291,7 +291,17 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         self.motions[..n_obst].copy_from_slice(&fluid.obstacles);
     }
 
+    /// One step (the kernels are compiled in this crate: `compiled`).
     pub fn step(&mut self, fluid: &mut Fluid<L, T>, out: Option<&mut Macro>) -> Result<(), LbmError> {
+        T::step_aa(self, fluid, out)
+    }
+
+    /// The body of [`StepperAa::step`], instantiated by `compiled` only.
+    pub(crate) fn step_generic(
+        &mut self,
+        fluid: &mut Fluid<L, T>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError> {
         self.exchange_forces(fluid);
         let n = fluid.nodes();
         let out = out.map(|m| {
