@@ -420,20 +420,35 @@ fn png_seeds() -> Vec<Vec<u8>> {
     out
 }
 
+/// The `.toml` files under `dir` of the repository (recursive, sorted), skipping `skip`.
+fn tomls(dir: &str, skip: &[&str]) -> Vec<PathBuf> {
+    fn walk(d: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "toml") {
+                out.push(p);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(&repo(dir), &mut out);
+    out.retain(|p| !skip.iter().any(|s| p.to_string_lossy().contains(s)));
+    out.sort();
+    out
+}
+
+/// Every scene of the repository (the 3D extruder's and the Su cases' included), and the small
+/// dry scene. The files they extend are copied beside the fuzzed copy, so that the mutations
+/// reach the merged scene and its checks, not only the `extends` line.
 fn scene_seeds() -> Vec<Vec<u8>> {
-    let mut v: Vec<Vec<u8>> = [
-        "scenes/dry-settle.toml",
-        "scenes/dry-compress.toml",
-        "scenes/dry-pushplate.toml",
-        "scenes/fluid-cavity.toml",
-        "scenes/fluid-cylinder-channel.toml",
-        "scenes/fluid-porous-mask.toml",
-        "scenes/coupled-float.toml",
-        "scenes/su2020/shear-base.toml",
-    ]
-    .iter()
-    .map(|p| read(p))
-    .collect();
+    scene_bases();
+    let mut v: Vec<Vec<u8>> = tomls("scenes", &["assemblies"])
+        .iter()
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
+    assert!(v.len() >= 40, "{} scenes", v.len());
     v.push(DRY.as_bytes().to_vec());
     v
 }
@@ -509,10 +524,10 @@ fn apply_overrides(bytes: &[u8]) -> bool {
 }
 
 fn pipeline_seeds() -> Vec<Vec<u8>> {
-    vec![
-        read("pipelines/quickstart.toml"),
-        read("pipelines/coupling-accuracy.toml"),
-    ]
+    tomls("pipelines", &[])
+        .iter()
+        .map(|p| std::fs::read(p).unwrap())
+        .collect()
 }
 
 fn parse_pipeline(bytes: &[u8]) -> bool {
@@ -541,14 +556,44 @@ fn params_seeds() -> Vec<Vec<u8>> {
         .next()
         .unwrap()
         .replace("[[stage.params.profiles]]", "[[profiles]]");
-    vec![
+    let mut out = vec![
         format!("radiograph\n{radiograph}").into_bytes(),
         [b"synth-radiograph\n".as_slice(), &read("data/synth-alcu/params.toml")].concat(),
         b"digitise\nimage = \"photo.jpg\"\npixel_size_m = 1e-4\ncontainer = { kind = \"auto-box\" }\nsmooth_px = 2.0\nmin_grain_area_px = 400\n".to_vec(),
         b"settling-study\nresolutions = [8, 12]\nmethods = [\"psm\", \"bounce-back\"]\nprecisions = [\"f64\", \"f32\"]\n".to_vec(),
         b"report\ntitle = \"t\"\n".to_vec(),
         b"simulate\nscene = \"scenes/dry-settle.toml\"\noverrides = { run = { steps = 10 } }\n".to_vec(),
-    ]
+    ];
+    // Every stage kind the pipelines use, with the parameters they give it (two per kind), and
+    // the assembly protocol's parameter files (`lbdem assemble`).
+    let mut per_kind = std::collections::BTreeMap::<String, usize>::new();
+    for p in tomls("pipelines", &[]) {
+        let t: toml::Table = toml::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        for s in t.get("stage").and_then(|s| s.as_array()).into_iter().flatten() {
+            let (Some(kind), Some(params)) = (s.get("kind").and_then(|k| k.as_str()), s.get("params")) else {
+                continue;
+            };
+            let n = per_kind.entry(kind.to_string()).or_default();
+            if *n < 2 {
+                *n += 1;
+                out.push(format!("{kind}\n{}", toml::to_string(params).unwrap()).into_bytes());
+            }
+        }
+    }
+    for p in tomls("scenes/su2020/assemblies", &[]) {
+        out.push([b"assemble\n".as_slice(), &std::fs::read(&p).unwrap()].concat());
+    }
+    let kinds: std::collections::BTreeSet<&str> = lbdem::registry::STAGES.iter().map(|k| k.kind).collect();
+    let seeded: std::collections::BTreeSet<&str> = out
+        .iter()
+        .filter_map(|s| std::str::from_utf8(s).ok()?.lines().next())
+        .collect();
+    assert!(
+        kinds.is_subset(&seeded),
+        "stage kinds without a seed: {:?}",
+        kinds.difference(&seeded)
+    );
+    out
 }
 
 fn prepare_params(bytes: &[u8]) -> bool {
@@ -637,20 +682,107 @@ fn read_initial_fluid(bytes: &[u8]) -> bool {
     lbdem::scenes::build::initial_fluid::read(&p, [4, 4, 1], 2, &kind, &units, 0.1).is_ok()
 }
 
-/// The small dry scene as a model, ready to restore a checkpoint into.
-fn dry_model() -> Box<dyn lbdem::scenes::timeloop::Model> {
-    let p = scratch().join("model.toml");
+/// A small liquid-only scene: a 12 x 10 lid-driven box.
+const FLUID: &str = r#"[lattice]
+collision = "trt"
+dx = 0.1
+tau = 0.8
+[domain]
+lo = [0.0, 0.0]
+hi = [1.2, 1.0]
+[fluid]
+density = 1000.0
+viscosity = 0.01
+u_max = 0.05
+[boundaries]
+y_max = { type = "wall", velocity = [0.05, 0.0] }
+[run]
+steps = 4
+"#;
+
+/// A small coupled scene: four buoyant grains in a 12 x 12 PSM lattice.
+const COUPLED: &str = r#"[domain]
+lo = [0.0, 0.0]
+hi = [0.0012, 0.0012]
+[particles]
+density = 2.55
+[particles.generate]
+count = 4
+lo = [0.0, 0.0]
+hi = [0.0012, 0.0012]
+seed = 5
+templates = [ { circles = [[0.0, 0.0, 1.3e-4], [1.1e-4, 0.0, 1.1e-4]] } ]
+[[walls]]
+box = [0.0, 0.0, 0.0012, 0.0012]
+[contact]
+law = "linear"
+k_n = 1.0e4
+k_t = 5.0e3
+damping = { ratio = 0.3 }
+mu = 0.4
+[dem]
+dt = 1.4e-6
+skin = 2.0e-5
+gravity = [0.0, -9.81]
+gravity_factor = -0.12
+[fluid]
+density = 2856.0
+dynamic_viscosity = 1.82e-3
+u_max = 0.02
+[lattice]
+collision = "bgk"
+dx = 1.0e-4
+dt = 5.6e-5
+[coupling]
+method = "psm"
+r_hd = 0.8
+depth = 1.0e-3
+[run]
+steps = 4
+"#;
+
+/// A small 3D extruder (Ness et al. 2017's model, barrel 8 d, die 4 d) from case A's file.
+const EXTRUDER: &str = r#"[scene]
+extends = "case-a.toml"
+[extruder]
+barrel_width = 8.0e-5
+barrel_length = 6.0e-5
+die_width = 4.0e-5
+die_length = 4.0e-5
+inlet_length = 3.0e-5
+prefill_phi = 0.2
+[run]
+time = 1.0e-6   # case A gives time, so no steps
+"#;
+
+/// The files the repository's scenes extend, copied once into the scratch directory (seeds are
+/// made on the test threads side by side, before `fuzz` serialises the targets).
+fn scene_bases() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        for base in ["scenes/ness2017/case-a.toml", "scenes/su2020/shear-base.toml"] {
+            let name = Path::new(base).file_name().unwrap();
+            std::fs::write(scratch().join(name), read(base)).unwrap();
+        }
+    });
+}
+
+/// A scene as a model, ready to restore a checkpoint into (the files scenes extend beside it).
+fn model(name: &str, scene: &str) -> Box<dyn lbdem::scenes::timeloop::Model> {
+    let p = scratch().join(format!("model-{name}.toml"));
+    scene_bases();
     if !p.exists() {
-        std::fs::write(&p, DRY).unwrap();
+        std::fs::write(&p, scene).unwrap();
     }
     let l = lbdem::scenes::schema::load(&p, &Default::default()).unwrap();
     lbdem::scenes::run::model(&l, true).unwrap()
 }
 
-fn checkpoint_seeds() -> Vec<Vec<u8>> {
-    let mut m = dry_model();
+/// The model's state fresh and after four steps (even: the AA kernel exports only then).
+fn checkpoint_seeds_of(name: &str, scene: &str) -> Vec<Vec<u8>> {
+    let mut m = model(name, scene);
     let fresh = serde_json::to_vec(&m.save().unwrap()).unwrap();
-    for _ in 0..3 {
+    for _ in 0..4 {
         m.step(false).unwrap();
     }
     vec![fresh, serde_json::to_vec(&m.save().unwrap()).unwrap()]
@@ -658,11 +790,11 @@ fn checkpoint_seeds() -> Vec<Vec<u8>> {
 
 /// A checkpoint's model state restored into a fresh model, then two steps: restoring refuses
 /// what it cannot use instead of leaving a state that panics later.
-fn restore_checkpoint(bytes: &[u8]) -> bool {
+fn restore_into(name: &str, scene: &str, bytes: &[u8]) -> bool {
     let Ok(v) = serde_json::from_slice::<serde_json::Value>(bytes) else {
         return false;
     };
-    let mut m = dry_model();
+    let mut m = model(name, scene);
     if m.restore(v).is_err() {
         return false;
     }
@@ -728,7 +860,10 @@ targets! {
     particle_csv: 10_000, particle_seeds(), text_bound, read_particles_csv;
     particle_header_json: 100_000, header_seeds(), text_bound, read_particles_header;
     snapshot_tables: 2_000, snapshot_seeds(), text_bound, read_snapshots;
-    checkpoint_json: 2_000, checkpoint_seeds(), text_bound, restore_checkpoint;
+    checkpoint_json: 2_000, checkpoint_seeds_of("dry", DRY), text_bound, |b: &[u8]| restore_into("dry", DRY, b);
+    checkpoint_fluid: 1_000, checkpoint_seeds_of("fluid", FLUID), text_bound, |b: &[u8]| restore_into("fluid", FLUID, b);
+    checkpoint_coupled: 1_000, checkpoint_seeds_of("coupled", COUPLED), text_bound, |b: &[u8]| restore_into("coupled", COUPLED, b);
+    checkpoint_extruder: 500, checkpoint_seeds_of("extruder", EXTRUDER), text_bound, |b: &[u8]| restore_into("extruder", EXTRUDER, b);
     fluid_initial: 5_000, initial_fluid_seeds(), text_bound, read_initial_fluid;
     assembly_header: 5_000, assembly_header_seeds(), text_bound, read_assembly_header;
     sweep_toml: 20_000, sweep_seeds(), text_bound, parse_sweep;
