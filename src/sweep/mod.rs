@@ -1,7 +1,8 @@
 //! `lbdem sweep SWEEP.toml`: a base scene or pipeline run over axes of parameters and random
 //! replicas, every case through the pipeline runner in a directory of its own (so a rerun
 //! skips finished cases, resumes interrupted ones and reruns what changed), side by side on
-//! the cores of one machine or spread over MPI ranks (`--features mpi`). A failed case is
+//! the cores of one machine or spread over MPI ranks (the `lbdem-mpi` binary of `crates/mpi`,
+//! which drives the same cases through [`plan`], [`local`] and [`finish`]). A failed case is
 //! reported and never stops the others. The declared scalar results of the finished cases make
 //! the tables (CSV and Parquet, ensemble statistics over replicas) and an HTML page of charts.
 //!
@@ -11,8 +12,6 @@
 pub mod cases;
 pub mod figures;
 pub mod local;
-#[cfg(feature = "mpi")]
-pub mod mpi;
 pub mod progress;
 pub mod results;
 pub mod schema;
@@ -76,12 +75,33 @@ pub fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
+/// Whether this process was started by an MPI launcher (mpirun, mpiexec, srun with PMI).
+pub fn launched_by_mpi() -> bool {
+    MPI_LAUNCHER_VARS.iter().any(|v| std::env::var_os(v).is_some())
+}
+
+/// What an MPI launcher sets in every rank's environment.
+const MPI_LAUNCHER_VARS: [&str; 4] = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"];
+
+/// A sweep file read and its cases expanded, before anything runs or is written.
+pub struct Plan {
+    pub sweep: Sweep,
+    pub out: PathBuf,
+    pub cases: Vec<Case>,
+}
+
+/// Read `file` and expand its cases under `out` (default: the sweep file's own `out`).
+pub fn plan(file: &Path, out: Option<PathBuf>) -> Result<Plan> {
+    let sweep = Sweep::load(file)?;
+    let out = out.unwrap_or_else(|| sweep.out.clone());
+    let cases = cases::expand(&sweep, &out)?;
+    Ok(Plan { sweep, out, cases })
+}
+
 /// `lbdem sweep`.
 pub fn run(args: &Args) -> Result<Summary> {
     let t0 = Instant::now();
-    let sweep = Sweep::load(&args.file)?;
-    let out = args.out.clone().unwrap_or_else(|| sweep.out.clone());
-    let cases = cases::expand(&sweep, &out)?;
+    let Plan { sweep, out, cases } = plan(&args.file, args.out.clone())?;
     if args.list {
         for c in &cases {
             println!("{:>5}  {}  {}", c.index, c.dir.display(), c.label());
@@ -95,9 +115,14 @@ pub fn run(args: &Args) -> Result<Summary> {
     }
     let parallel = args.parallel.unwrap_or(sweep.parallel);
     let threads = args.threads.unwrap_or(sweep.threads);
-    #[cfg(feature = "mpi")]
-    if mpi::launched() {
-        return mpi::run(&sweep, &out, &cases, threads, args.force, t0);
+    if launched_by_mpi() {
+        bail!(
+            "`lbdem sweep` was started by an MPI launcher, but it runs on one machine: every rank \
+             would run every case of {}. Run the MPI binary instead, `mpirun -n N lbdem-mpi sweep {}` \
+             (built by `cargo build --release -p lbdem-mpi`, which needs Open MPI: docs/scaling.md)",
+            sweep.file.display(),
+            args.file.display()
+        );
     }
     let (parallel, threads) = slots(cases.len(), cores(), parallel, threads)
         .with_context(|| format!("sweep file {}", sweep.file.display()))?;

@@ -1,4 +1,4 @@
-//! A sweep over MPI ranks (`--features mpi`, run under `mpirun -n N lbdem sweep ...`): every
+//! A sweep over MPI ranks (run under `mpirun -n N lbdem-mpi sweep ...`): every
 //! rank expands the same cases from the sweep file; rank 0 hands them out one at a time to
 //! whichever rank asks (dynamic assignment, so long and short cases balance), runs cases
 //! itself on a second thread meanwhile, and gathers every outcome; then it alone writes the
@@ -10,24 +10,17 @@
 //! than block, so its dispatcher costs no core. The case directories must be on a filesystem
 //! every rank sees (as a cluster's home or scratch is), or rank 0's page links to nothing.
 
-use super::cases::Case;
-use super::local::{self, CaseOpts, Outcome, Queue};
-use super::progress::SweepProgress;
-use super::schema::Sweep;
-use super::{Summary, finish};
 use anyhow::{Context, Result};
+use lbdem::sweep::cases::Case;
+use lbdem::sweep::local::{self, CaseOpts, Outcome, Queue};
+use lbdem::sweep::progress::SweepProgress;
+use lbdem::sweep::schema::Sweep;
+use lbdem::sweep::{Summary, finish};
 use mpi::traits::*;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
-
-/// Whether this process was started by an MPI launcher (mpirun, mpiexec, srun with PMI).
-pub fn launched() -> bool {
-    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "MPI_LOCALNRANKS"]
-        .iter()
-        .any(|v| std::env::var_os(v).is_some())
-}
 
 #[derive(Serialize, Deserialize)]
 struct Request {
@@ -50,10 +43,10 @@ pub fn run(
     let node = world.split_shared(rank);
     let per_node = node.size().max(1) as usize;
     let threads = match threads {
-        0 => (super::cores() / per_node).max(1),
+        0 => (lbdem::sweep::cores() / per_node).max(1),
         t => t,
     };
-    crate::contract::set_quiet(true);
+    lbdem::contract::set_quiet(true);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let opts = CaseOpts {
         sweep_file: &sweep.file,
