@@ -4,7 +4,8 @@
 # and keeps every output in DIR/{old,new}-<round>.txt for the comparison table.
 #   scripts/paired-bench.sh OLD_BINARY NEW_BINARY ROUNDS DIR WHICH [ARGS...]
 # Example (the architecture issue's "no figure moves" check):
-#   scripts/paired-bench.sh /tmp/lbdem-old target/release/lbdem 3 target/paired lbm --reps 3
+#   cp target/release/lbdem target/lbdem-old   # before the change, then rebuild
+#   scripts/paired-bench.sh target/lbdem-old target/release/lbdem 3 target/paired lbm --reps 3
 set -euo pipefail
 old=$1 new=$2 rounds=$3 dir=$4
 shift 4

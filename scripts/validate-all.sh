@@ -82,8 +82,14 @@ while IFS='|' read -r crate file name figure reference tolerance; do
   echo "== $id ($(date -u +%H:%M:%S), load $(cut -d' ' -f1 /proc/loadavg))" >&2
   t0=$(date +%s.%N)
   # file "lib": a test of the crate's library (src/**/tests), found by its name.
-  if [ "$file" = lib ]; then target=(--lib); exact=(); else target=(--test "$file"); exact=(--exact); fi
-  if cargo test --release --quiet -p "$crate" "${target[@]}" -- --ignored "${exact[@]}" "$name" --nocapture >"$log" 2>&1; then
+  # The engine crates have one test binary each (tests/main.rs, named after the crate), whose
+  # tests are <file>::<name>; the lbdem crate keeps one binary per file.
+  case "$crate" in
+    lbdem-lbm | lbdem-coupling | lbdem-dem) suite=${crate#lbdem-}; full="$file::$name" ;;
+    *) suite=$file; full=$name ;;
+  esac
+  if [ "$file" = lib ]; then target=(--lib); exact=(); else target=(--test "$suite"); exact=(--exact); fi
+  if cargo test --release --quiet -p "$crate" "${target[@]}" -- --ignored "${exact[@]}" "$full" --nocapture >"$log" 2>&1; then
     pass=yes
   else
     pass=NO

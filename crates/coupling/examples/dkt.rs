@@ -1,6 +1,6 @@
 //! The drafting-kissing-tumbling case of Uhlmann (2005) as CSV on stdout, for plotting against
 //! the digitised curves in `tests/data/`:
-//! `cargo run --release -p lbdem-coupling --example dkt -- [CELLS_PER_DIAMETER] [U_LATTICE] [CONTACT_RANGE_CELLS]`
+//! `cargo run --release -p lbdem-coupling --example dkt --features probes -- [CELLS_PER_DIAMETER] [U_LATTICE] [CONTACT_RANGE_CELLS]`
 //! (`DKT_NO_CORRECTION=1` switches the interior-liquid correction off).
 
 use lbdem_coupling::cases::dkt::{DktSpec, run};

@@ -10,7 +10,7 @@
 //! potential-flow value ρ_p/ρ_f + 1 (the early drag only adds to it; the excess β is printed).
 //! Measured over LBM steps 60-120, once sound has crossed a diameter about twice.
 
-mod common;
+use crate::common;
 use common::walled_box;
 use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
 use lbdem_coupling::units::CouplingUnits;

@@ -4,7 +4,7 @@
 //! differences between successive levels shrinking at least by half per doubling, and the
 //! Eq. 14 drag on all disks must balance the force on the liquid.
 
-mod common;
+use crate::common;
 use common::*;
 use lbdem_coupling::PsmFluid;
 use lbdem_coupling::solid_fraction::GrainCircle;

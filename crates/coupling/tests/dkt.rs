@@ -9,7 +9,7 @@
 //! the gap closes below a tenth of a diameter (kissing); the trailing disk ends half a diameter
 //! below the leading one (tumbling). The thresholds are this test's choice, not published ones.
 
-mod common;
+use crate::common;
 use common::walled_box;
 use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
 use lbdem_coupling::units::CouplingUnits;
@@ -95,7 +95,7 @@ fn two_disks_draft_kiss_and_tumble() {
 }
 
 /// Finer lattices: the phase times should settle as the disks are resolved better:
-/// `cargo test --release -p lbdem-coupling --test dkt -- --ignored --nocapture`.
+/// `cargo test --release -p lbdem-coupling --test coupling dkt:: -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn dkt_phases_at_finer_resolution() {

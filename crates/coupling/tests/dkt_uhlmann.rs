@@ -23,7 +23,7 @@
 //! either way here): at 16 cells per diameter offsets of d/500, d/250 and d/125 tumble at 0.282,
 //! 0.260 and 0.240 s, and 16 cells sits 2 ms inside the band. CI therefore runs 24 cells per
 //! diameter (tumble 14 ms inside the band; about 30 s). `cargo test --release -p lbdem-coupling
-//! --test dkt_uhlmann -- --ignored --nocapture` runs 16 cells per diameter with the variants
+//! --test coupling dkt_uhlmann:: -- --ignored --nocapture` runs 16 cells per diameter with the variants
 //! without the interior-liquid correction and with BGK (to show what each choice does), and the
 //! resolution series at 32 and 48 cells per diameter (about 4 minutes on two cores) and at 64
 //! (about 13 minutes).
@@ -344,7 +344,7 @@ fn finer_lattices_converge_into_the_published_envelope() {
 /// 64 cells per diameter, the third point of the series. u_lattice 0.05: at 0.08 the density in
 /// the gap falls to 0.5 as the kissing pair opens (t ≈ 0.21 s) and the run stops. About 13
 /// minutes in release on two quiet cores (42,636 steps of 786,432 nodes); alone:
-/// `cargo test --release -p lbdem-coupling --test dkt_uhlmann -- --ignored --nocapture finest_lattice`.
+/// `cargo test --release -p lbdem-coupling --test coupling dkt_uhlmann::finest_lattice -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn finest_lattice_stays_in_the_published_envelope() {

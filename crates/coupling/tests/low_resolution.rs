@@ -15,7 +15,7 @@
 //! offsets of the centre (0 or ½ cell along x and y), and the spread is printed.
 //!
 //! The fine-lattice reference of the packing is run by the ignored test:
-//! `cargo test --release -p lbdem-coupling --test low_resolution -- --ignored --nocapture`
+//! `cargo test --release -p lbdem-coupling --test coupling low_resolution:: -- --ignored --nocapture`
 //! (about 1 minute on two cores).
 
 use lbdem_coupling::cases::resolution::*;
@@ -161,7 +161,7 @@ fn packing_permeability_against_fine_lattice() {
 /// The fine-lattice reference of the packing (`FINE_K`): 20 and 40 cells per diameter, unshifted,
 /// extrapolated at second order; the constant must be within 0.5 % of the rerun, and the
 /// differences from 10 to 20 to 40 cells must shrink at least 3× (second order: 4×).
-/// `cargo test --release -p lbdem-coupling --test low_resolution -- --ignored --nocapture`
+/// `cargo test --release -p lbdem-coupling --test coupling low_resolution:: -- --ignored --nocapture`
 /// (about 40 s on two cores).
 #[test]
 #[ignore]
@@ -180,7 +180,7 @@ fn fine_lattice_reference() {
 /// The disk arrays on the fine lattice (40 cells per diameter, unshifted) against Sangani &
 /// Acrivos Table 1: measured −0.25, −1.5 and −7.4 % at Φ = 0.1, 0.3 and 0.5 (the gap at Φ = 0.5
 /// is only 10 cells); asserted within 0.5, 3 and 15 %.
-/// `cargo test --release -p lbdem-coupling --test low_resolution -- --ignored --nocapture`
+/// `cargo test --release -p lbdem-coupling --test coupling low_resolution:: -- --ignored --nocapture`
 /// (about 20 s).
 #[test]
 #[ignore]

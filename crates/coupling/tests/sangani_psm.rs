@@ -6,7 +6,7 @@
 //! force on the cylinder must equal g Σ(1 − B) (all the momentum put in ends on the cylinder), and
 //! F/(μU) = g L² / (ν U) at ρ = 1 (F = G L² includes the pressure's share on the solid area).
 
-mod common;
+use crate::common;
 use common::*;
 use lbdem_coupling::PsmFluid;
 use lbdem_coupling::solid_fraction::GrainCircle;
@@ -76,7 +76,7 @@ fn drag_matches_table_at_two_resolutions() {
 }
 
 /// All fractions at both resolutions:
-/// `cargo test --release -p lbdem-coupling --test sangani_psm -- --ignored --nocapture`.
+/// `cargo test --release -p lbdem-coupling --test coupling sangani_psm:: -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn drag_matches_table_full() {

@@ -1,6 +1,6 @@
 //! Quick profiling harness for the pair loop (not the benchmark: `lbdem bench dem` is).
-//! `cargo run --release -p lbdem-dem --example dem_rate -- [THREADS] [STEPS] [TILE]`
-//! Caches the prepared 10k packing in /tmp/lbdem_dem_rate_10k.json.
+//! `cargo run --release -p lbdem-dem --example dem_rate --features probes -- [THREADS] [STEPS] [TILE]`
+//! Caches the prepared 10k packing in the system temporary directory (lbdem_dem_rate_10k.json).
 
 use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::{Damping, StepParams, Stepper, System, Vec2, generate};
@@ -12,8 +12,8 @@ fn main() {
     let steps = a.get(1).copied().unwrap_or(2000);
     let tile = a.get(2).copied().unwrap_or(1);
     let law = LinearSpringDashpot::new(2.0e4, 2.0e4 * 2.0 / 7.0, Damping::Gamma(100.0), 0.5);
-    let cache = "/tmp/lbdem_dem_rate_10k.json";
-    let s10 = match std::fs::read(cache) {
+    let cache = std::env::temp_dir().join("lbdem_dem_rate_10k.json");
+    let s10 = match std::fs::read(&cache) {
         Ok(b) => System::from_checkpoint(&b).unwrap(),
         Err(_) => {
             let mut s = generate::bidisperse_lattice(100, 1.0, 1.4, 1.42, 4821).unwrap();
@@ -24,7 +24,7 @@ fn main() {
             for _ in 0..3000 {
                 st.step_linear(&p, &law, &mut s).unwrap();
             }
-            std::fs::write(cache, s.to_checkpoint()).unwrap();
+            std::fs::write(&cache, s.to_checkpoint()).unwrap();
             s
         }
     };

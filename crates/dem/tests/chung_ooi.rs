@@ -12,7 +12,7 @@
 //! them is bounded by their resolution. Every tolerance is about twice the error measured here
 //! (in a comment).
 //!
-//! Run: `cargo test -p lbdem-dem --test chung_ooi -- --nocapture` (about a second; CI runs it).
+//! Run: `cargo test -p lbdem-dem --test dem chung_ooi:: -- --nocapture` (about a second; CI runs it).
 
 use lbdem_dem::spheres::{
     Domain3, Elastic, HertzMindlinSpring, PlaneWall, SphereStepParams, SphereStepper, SphereSystem, Surface,

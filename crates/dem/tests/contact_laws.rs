@@ -57,6 +57,11 @@ fn hertz_contact_duration() {
     let dmax = (15.0 * m_eff * v * v / (16.0 * e_star * r_eff.sqrt())).powf(0.4);
     let tc = 2.943275 * dmax / v;
     let (e, dur) = collide(&law, v, tc / 5000.0);
+    eprintln!(
+        "Hertz: t_c error {:.2e}, restitution - 1 = {:.2e}",
+        (dur - tc).abs() / tc,
+        e - 1.0
+    );
     assert!((dur - tc).abs() / tc < 1e-3, "Hertz t_c = {dur}, analytic {tc}");
     assert!((e - 1.0).abs() < 1e-3, "undamped Hertz must be elastic, e = {e}");
 }

@@ -1,6 +1,6 @@
 //! Determinism, checkpoint/resume, the cell list against brute force, and the time-step guard.
 
-mod common;
+use crate::common;
 use common::bits;
 use lbdem_dem::contact::{LinearSpringDashpot, Rolling};
 use lbdem_dem::neighbor::{CellList, brute_force_pairs};

@@ -4,7 +4,7 @@
 //! Hertz-Mindlin damping on the mobile mass), frozen grains do not move and carry the load,
 //! pairs of frozen grains are left out of the list, mobile-frozen contacts slide with μ_w.
 //!
-//! Run: `cargo test -p lbdem-dem --test frozen -- --nocapture`.
+//! Run: `cargo test -p lbdem-dem --test dem frozen:: -- --nocapture`.
 
 use lbdem_dem::spheres::{
     Domain3, Elastic, HertzMindlinSpring, LinearSpring, SphereError, SphereLaw, SphereStepParams,

@@ -2,7 +2,7 @@
 //! with more history than the 4 f64 of the built-in laws, and a user force hook, all through
 //! the normal `Stepper` (no stepper or kernel edit).
 
-mod common;
+use crate::common;
 use lbdem_dem::contact::{ContactInput, ContactOutput, LinearSpringDashpot};
 use lbdem_dem::*;
 

@@ -3,9 +3,9 @@
 //! them against the same pair inside the box, and a checkpoint of a sheared suspension resumed
 //! bit for bit. The engine is serial, so there is no thread-count test (one could not fail).
 //!
-//! Run: `cargo test -p lbdem-dem --test lees_edwards -- --nocapture`.
+//! Run: `cargo test -p lbdem-dem --test dem lees_edwards:: -- --nocapture`.
 
-mod suspension;
+use crate::suspension;
 
 use lbdem_dem::spheres::{Domain3, LinearSpring, SphereLaw, SphereStepParams, SphereStepper, SphereSystem};
 use lbdem_dem::{Vec3, Vector};

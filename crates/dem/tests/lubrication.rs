@@ -4,7 +4,7 @@
 //! approach against its closed-form stopping gap; the viscous time-step limit pinned to the
 //! scheme's stability boundary; an elastic linear-spring collision.
 //!
-//! Run: `cargo test -p lbdem-dem --test lubrication -- --nocapture`.
+//! Run: `cargo test -p lbdem-dem --test dem lubrication:: -- --nocapture`.
 
 use lbdem_dem::spheres::{
     Domain3, Interaction, LinearSpring, Lubricated, Lubrication, SphereError, SphereLaw, SphereStepParams,

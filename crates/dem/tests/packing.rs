@@ -5,7 +5,7 @@
 //! fraction (REFERENCES.md; PEERS.md: μ = 0.5 disks are not jammed at 0.80 in the LAMMPS protocol).
 //!
 //! The test uses ~1000 disks; the full version (4000 disks) runs with
-//! `cargo test --release -p lbdem-dem --test packing -- --ignored`.
+//! `cargo test --release -p lbdem-dem --test dem packing:: -- --ignored`.
 //! Tolerance: 0.84 ± 0.02 covers the finite-size spread of φ_J at N ~ 10³ reported by O'Hern
 //! et al. (their Fig. on the width of the φ_J distribution) and the finite compression rate.
 //! Measured (2026-11-26): frictionless φ = 0.8399 at 1000 disks, 0.8416 at 4000; μ = 0.5:
@@ -249,7 +249,7 @@ fn isotropic_compression_packing_fraction_quick() {
 }
 
 #[test]
-#[ignore = "full size (4000 disks): cargo test --release -p lbdem-dem --test packing -- --ignored"]
+#[ignore = "full size (4000 disks): cargo test --release -p lbdem-dem --test dem packing:: -- --ignored"]
 fn isotropic_compression_packing_fraction_full() {
     check(4000);
 }

@@ -1,7 +1,7 @@
 //! The batched (eight pairs per instruction) linear pair kernel against the generic pair loop:
 //! the same trajectories bit for bit, and the same on 1 and 2 threads.
 
-mod common;
+use crate::common;
 use common::bits;
 use lbdem_dem::contact::{ContactInput, ContactOutput, LinearSpringDashpot};
 use lbdem_dem::*;

@@ -3,7 +3,7 @@
 //! sphere-wall histories; a removal continues bit for bit as an assembly built without the
 //! removed spheres from the same state, and a checkpoint taken after it resumes bit for bit.
 //!
-//! Run: `cargo test -p lbdem-dem --test removal -- --nocapture`.
+//! Run: `cargo test -p lbdem-dem --test dem removal:: -- --nocapture`.
 
 use lbdem_dem::spheres::{
     Domain3, LinearSpring, PlaneWall, SphereError, SphereLaw, SphereStepParams, SphereStepper, SphereSystem,

@@ -13,10 +13,10 @@
 //! Units: small diameter d = 1, density ρ = 1, viscosity η = 1, so the shear rate is the Stokes
 //! number St = ρ γ̇ d²/η. Quick (CI) and full (`#[ignore]`) runs; figures in `docs/dem3d.md`.
 //!
-//! Run: `cargo test -p lbdem-dem --test shear_rheology -- --nocapture` (CI case) and
-//! `cargo test -p lbdem-dem --test shear_rheology -- --ignored --nocapture` (flow curve).
+//! Run: `cargo test -p lbdem-dem --test dem shear_rheology:: -- --nocapture` (CI case) and
+//! `cargo test -p lbdem-dem --test dem shear_rheology:: -- --ignored --nocapture` (flow curve).
 
-mod suspension;
+use crate::suspension;
 
 use lbdem_dem::Vector;
 use lbdem_dem::spheres::{SphereLaw, SphereStepParams, SphereStepper, dipole_stress};

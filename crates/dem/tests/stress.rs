@@ -3,7 +3,7 @@
 //! compressed lattice between two walls, periodic across them, gives the same σ_zz as the load on
 //! the walls and the closed-form σ_xx of its pairs; the lubrication part is reported apart.
 //!
-//! Run: `cargo test -p lbdem-dem --test stress -- --nocapture`.
+//! Run: `cargo test -p lbdem-dem --test dem stress:: -- --nocapture`.
 
 use lbdem_dem::spheres::{
     Domain3, LinearSpring, Lubricated, Lubrication, Partner, PlaneWall, SphereLaw, SphereStepParams,

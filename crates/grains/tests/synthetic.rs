@@ -111,6 +111,7 @@ fn fits_two_circle_grains_with_their_elongation() {
     });
     let d = digitise(s.image.view(), &Params::default()).expect("digitise");
     let (mut n_two, mut n_disk) = (0, 0);
+    let (mut worst_t, mut worst_fit) = (0.0f64, 0.0f64);
     for g in &s.grains {
         let l = d.labels[[g.y as usize, g.x as usize]] as usize;
         let fit = &d.fits[l - 1];
@@ -122,6 +123,8 @@ fn fits_two_circle_grains_with_their_elongation() {
                 "grain with t = {} fitted by one circle",
                 g.t
             );
+            worst_t = worst_t.max((fit.t - g.t).abs());
+            worst_fit = worst_fit.max(fit.error);
             assert!((fit.t - g.t).abs() < 0.1, "t {} fitted as {}", g.t, fit.t);
             assert!(fit.error < 0.1, "fit error {}", fit.error);
         } else if g.t == 0.0 {
@@ -134,6 +137,9 @@ fn fits_two_circle_grains_with_their_elongation() {
             );
         }
     }
+    eprintln!(
+        "{n_two} two-circle grains: worst |t error| {worst_t:.4}, worst fit error {worst_fit:.4}; {n_disk} disks"
+    );
     assert!(n_two > 20 && n_disk > 20);
 }
 

@@ -1,6 +1,6 @@
 //! Time of the edge flag (`lbdem_imaging::edge::Flagger`) on a 2048² field of 60 px disks
 //! (window 120 px, REV 190 px: the `lbdem bench radiograph` geometry), median of 11:
-//! `cargo run --release -p lbdem-imaging --example flag_timing`. The figure in `edge.rs`'s
+//! `cargo run --release -p lbdem-imaging --example flag_timing --features probes`. The figure in `edge.rs`'s
 //! documentation comes from here.
 use lbdem_imaging::Roi;
 use lbdem_imaging::edge::{BulkPhase, Flagger};

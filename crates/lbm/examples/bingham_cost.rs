@@ -2,7 +2,7 @@
 //! Newtonian one on the same case, AA kernel, D2Q9 BGK f64, periodic, best of 5 × 50 steps each,
 //! the two timed back to back so the ratio survives other load. Indicative only: the benchmark
 //! proper is issue 20 item 5 (`lbdem bench`), with its peer in the same run.
-//! `cargo run --release -p lbdem-lbm --example bingham_cost -- [NX NY]` (default 256 192)
+//! `cargo run --release -p lbdem-lbm --example bingham_cost --features probes -- [NX NY]` (default 256 192)
 
 use lbdem_lbm::bingham::Bingham;
 use lbdem_lbm::{Collision, D2Q9, Domain, Face, Fluid, Limits, Settings, StepperAa};

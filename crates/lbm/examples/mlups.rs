@@ -3,7 +3,7 @@
 //! (`Partition::Rows(4)`, then `Partition::Contiguous`: an A/B of the partition in one process),
 //! then the nine-pass in-place ceiling and the fused in-place bound (`roofline::in_place_pass`)
 //! on arrays of the same size, so that the printed ratios are robust to other load on the machine.
-//! `cargo run --release -p lbdem-lbm --example mlups -- NX NY f64|f32 THREADS [REPS] [bgk|trt] [aa|two] [WORK]`
+//! `cargo run --release -p lbdem-lbm --example mlups --features probes -- NX NY f64|f32 THREADS [REPS] [bgk|trt] [aa|two] [WORK]`
 
 use lbdem_lbm::layout::Layout;
 use lbdem_lbm::{

@@ -3,7 +3,7 @@
 //! D3Q19, f64 and f32), the same forces, and identical results for 1 and 2 threads.
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, D3Q19, Lattice, Partition, Real, Stepper, StepperAa};
 

@@ -9,7 +9,7 @@
 //! and checkpoint/resume do not change a bit, and bad parameters are refused.
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::{
     Bingham, Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, LbmError, Macro, Real, Stepper, StepperAa,

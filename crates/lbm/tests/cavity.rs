@@ -3,7 +3,7 @@
 //! Lid = halfway bounce-back wall moving at U (Leonardi Eq. 19); the other walls at rest.
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, Domain, Face, Fluid, Stepper};
 
@@ -54,7 +54,7 @@ fn re100_matches_ghia() {
     assert!(err < 0.012, "{err}");
 }
 
-/// `cargo test --release -p lbdem-lbm --test cavity -- --ignored`
+/// `cargo test --release -p lbdem-lbm --test lbm cavity:: -- --ignored`
 #[test]
 #[ignore]
 fn re1000_matches_ghia() {

@@ -4,7 +4,7 @@
 //! two-fluid Couette profile. Also the checkpoint round trip of the plain fluid (AA and two-array).
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::{
     Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, LbmError, Macro, Real, Stepper, StepperAa,

@@ -6,7 +6,7 @@
 //! Pan, Luo & Miller, Comput. Fluids 35 (2006) 898). A correct code matches it to round-off.
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, Stepper};
 

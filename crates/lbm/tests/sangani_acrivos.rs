@@ -5,7 +5,7 @@
 //! pressure gradient G, which a uniform body force g on the fluid reproduces (G = g).
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Motion, Stepper};
 
@@ -70,7 +70,7 @@ fn drag_matches_table_quick() {
     check(48, &[1, 2, 3], 0.035);
 }
 
-/// Full table at L = 128: `cargo test --release -p lbdem-lbm --test sangani_acrivos -- --ignored`.
+/// Full table at L = 128: `cargo test --release -p lbdem-lbm --test lbm sangani_acrivos:: -- --ignored`.
 #[test]
 #[ignore]
 fn drag_matches_table_full() {

@@ -8,7 +8,7 @@
 //! finite or be stopped with the diagnosis.
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::cases::taylor_green::{self, Spec, Verdict};
 use lbdem_lbm::{Collision, D2Q9, Fluid, LbmError, Stepper};

@@ -3,7 +3,7 @@
 //! Proc. R. Soc. A 158 (1937) 499).
 
 #![allow(clippy::needless_range_loop)]
-mod common;
+use crate::common;
 use common::*;
 use lbdem_lbm::{Collision, D2Q9, Domain, Fluid, Macro, Stepper};
 use std::f64::consts::PI;
