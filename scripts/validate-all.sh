@@ -21,6 +21,7 @@ lbdem-lbm|sangani_acrivos|drag_matches_table_full|drag of a square array of cyli
 lbdem-dem|packing|isotropic_compression_packing_fraction_full|jamming packing fraction of 4000 frictionless bidisperse disks, compressed to the target wall stress|O'"'"'Hern et al. 2003: φ_J ≈ 0.84|± 0.02 (measured 0.8416)
 lbdem-coupling|sangani_psm|drag_matches_table_full|PSM drag of cylinder arrays at 32 and 64 cells, Φ = 0.1-0.3|Sangani & Acrivos 1982 Table 1|7 % at 32, 2.5 % at 64, error halves
 lbdem-coupling|settling_disk|settling_converges_with_resolution|terminal velocity of a disk between walls at 10, 16, 24 cells/d|Faxén 1946 wall-corrected Stokes drag|PSM 6 % and falling to < 1.5 %; bounce-back 1.5 %
+lbdem-coupling|darcy|permeability_reference_from_fine_levels|permeability k/L² of a random packing of 14 disks (Φ = 0.30) at L = 64, 128, 256, Richardson-extrapolated|the test'"'"'s FINE_K (second order: ratio 3.87)|1e-6 (the constant it prints)
 lbdem-coupling|low_resolution|fine_lattice_reference|permeability k/d̄² of the two-circle packing at 10, 20, 40 cells, Richardson-extrapolated|the test'"'"'s FINE_K (second order)|0.5 %
 lbdem-coupling|low_resolution|fine_disk_arrays_meet_the_table|drag of disk arrays at 40 cells/d, Φ = 0.1, 0.3, 0.5|Sangani & Acrivos 1982 Table 1|0.5 %, 3 %, 15 %
 lbdem-coupling|dkt|dkt_phases_at_finer_resolution|drafting, kissing, tumbling of two disks at 12 and 16 cells/d|Glowinski et al. 2001 set-up (phases only)|the three phases occur (test'"'"'s thresholds)

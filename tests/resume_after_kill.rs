@@ -19,6 +19,23 @@ fn kill_and_resume(scene: &str, files: &[&str]) {
     let p = path.to_str().unwrap();
     let (ok, err) = run(&["simulate", p, "--out", a.to_str().unwrap()]);
     assert!(ok, "{err}");
+    start_and_kill(p, &b);
+    let (ok, err) = run(&["simulate", p, "--out", b.to_str().unwrap(), "--resume"]);
+    assert!(ok, "{err}");
+    assert!(err.contains("resuming at step"), "{err}");
+    for f in files {
+        let (x, y) = (read(&a, f), read(&b, f));
+        assert!(
+            x == y,
+            "{f} differs between the whole and the killed-and-resumed run"
+        );
+    }
+    let manifest: serde_json::Value = serde_json::from_slice(&read(&b, "stage.json")).unwrap();
+    assert_eq!(manifest["resumed"], true);
+}
+
+/// Start `lbdem simulate SCENE --out B` and SIGKILL it right after its first checkpoint.
+fn start_and_kill(p: &str, b: &Path) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_lbdem"))
         .args(["simulate", p, "--out", b.to_str().unwrap()])
         .stderr(std::process::Stdio::null())
@@ -39,27 +56,14 @@ fn kill_and_resume(scene: &str, files: &[&str]) {
         !b.join("stage.json").exists(),
         "the run finished before the kill: make the scene longer"
     );
-    let (ok, err) = run(&["simulate", p, "--out", b.to_str().unwrap(), "--resume"]);
-    assert!(ok, "{err}");
-    assert!(err.contains("resuming at step"), "{err}");
-    for f in files {
-        let (x, y) = (read(&a, f), read(&b, f));
-        assert!(
-            x == y,
-            "{f} differs between the whole and the killed-and-resumed run"
-        );
-    }
-    let manifest: serde_json::Value = serde_json::from_slice(&read(&b, "stage.json")).unwrap();
-    assert_eq!(manifest["resumed"], true);
 }
 
 fn read(dir: &Path, f: &str) -> Vec<u8> {
     std::fs::read(dir.join(f)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(f).display()))
 }
 
-#[test]
-fn grains_resume_bitwise_after_sigkill() {
-    let scene = r#"
+/// 80 two-circle grains settling in a box, long enough to be killed after a checkpoint.
+const GRAINS: &str = r#"
 [domain]
 lo = [0.0, 0.0]
 hi = [0.01, 0.01]
@@ -91,6 +95,10 @@ series = { every = 500 }
 snapshots = { every = 20000 }
 checkpoints = { every = 2000 }
 "#;
+
+#[test]
+fn grains_resume_bitwise_after_sigkill() {
+    let scene = GRAINS;
     kill_and_resume(
         scene,
         &[
@@ -206,5 +214,39 @@ fn shear_cell_resumes_bitwise_after_sigkill() {
             "snapshots/fluid_000000080.csv",
             "snapshots/particles_000000080.csv",
         ],
+    );
+}
+
+/// A damaged checkpoint of a 2D dry run (a clump's circle range cut, as a truncated or edited
+/// file could leave it) is refused on `--resume` with the reason, instead of the panic inside
+/// the contact kernel the fuzzer found before `System::check_state` (docs/fuzzing.md).
+#[test]
+fn a_damaged_dry_checkpoint_is_refused_not_panicked() {
+    let t = tempfile::tempdir().unwrap();
+    let path = t.path().join("scene.toml");
+    std::fs::write(&path, GRAINS).unwrap();
+    let b = t.path().join("b");
+    let p = path.to_str().unwrap();
+    start_and_kill(p, &b);
+    let ck = b.join(".partial/checkpoint.json");
+    let mut v: serde_json::Value = serde_json::from_slice(&read(&b, ".partial/checkpoint.json")).unwrap();
+    let starts = v["model"]["system"]["bodies"]["circle_start"]
+        .as_array_mut()
+        .expect("a dry checkpoint holds the clumps' circle ranges");
+    starts.pop();
+    std::fs::write(&ck, serde_json::to_vec(&v).unwrap()).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_lbdem"))
+        .args(["simulate", p, "--out", b.to_str().unwrap(), "--resume"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "refused with exit code 1, not a panic (101): {err}"
+    );
+    assert!(
+        err.contains("inconsistent") && err.contains("circle_start"),
+        "{err}"
     );
 }

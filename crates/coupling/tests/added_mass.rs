@@ -81,7 +81,8 @@ fn check(rho_p: f64) {
         m_with - potential
     );
     assert!(
-        ((m_without - m_with) - 1.0).abs() < 0.05,
+        // Measured 0.996 (ρ_p/ρ_f = 1.25) and 0.992 (1.5).
+        ((m_without - m_with) - 1.0).abs() < 0.016,
         "the correction gave back {} ρ_f V, not 1",
         m_without - m_with
     );

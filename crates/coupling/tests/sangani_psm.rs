@@ -67,6 +67,8 @@ fn check(l: usize, phis: &[usize], tol: f64) -> Vec<f64> {
 /// must fall with resolution.
 #[test]
 fn drag_matches_table_at_two_resolutions() {
+    // Measured (test profile, deterministic): L = 32 -4.60 %, -4.33 %, -6.30 % at Φ = 0.1-0.3;
+    // L = 64 -1.15 % at Φ = 0.2.
     let coarse = check(32, &[0, 1, 2], 0.07);
     let fine = check(64, &[1], 0.025);
     assert!(
@@ -109,5 +111,6 @@ fn trt_reduces_to_bgk_and_meets_the_table() {
         100.0 * err
     );
     assert!((balance - 1.0).abs() < 1e-4, "force balance {balance}");
-    assert!(err.abs() < 0.07, "TRT: {trt} vs {want}");
+    // Measured -2.54 % (L = 32, τ = 0.6, Φ = 0.2).
+    assert!(err.abs() < 0.05, "TRT: {trt} vs {want}");
 }

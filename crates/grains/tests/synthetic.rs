@@ -83,10 +83,12 @@ fn recovers_count_size_fraction_and_areas() {
             s.solid_fraction,
             c.worst_area_err,
         );
-        assert!(c.count_err <= 0.02, "seed {seed}: count error {}", c.count_err);
-        assert!(c.d_err <= 0.03, "seed {seed}: mean diameter error {}", c.d_err);
+        // Measured over seeds 1-3: count 0 (one grain of 160 would be 0.006), mean diameter
+        // 0.0007-0.0009, solid fraction 0.0008-0.0011, worst area 0.029-0.040.
+        assert!(c.count_err <= 0.007, "seed {seed}: count error {}", c.count_err);
+        assert!(c.d_err <= 0.002, "seed {seed}: mean diameter error {}", c.d_err);
         assert!(
-            c.phi_err <= 0.02,
+            c.phi_err <= 0.0025,
             "seed {seed}: solid fraction error {}",
             c.phi_err
         );
@@ -97,7 +99,13 @@ fn recovers_count_size_fraction_and_areas() {
             c.worst_area_err
         );
         // The fitted circles cover the image's solid fraction too.
-        assert!((d.solid_fraction_fitted - s.solid_fraction).abs() <= 0.02);
+        let fitted = (d.solid_fraction_fitted - s.solid_fraction).abs();
+        eprintln!("seed {seed}: fitted circles' solid fraction error {fitted:.4}");
+        // Measured 0.0007-0.0009.
+        assert!(
+            fitted <= 0.002,
+            "seed {seed}: fitted solid fraction error {fitted}"
+        );
     }
 }
 
@@ -125,8 +133,9 @@ fn fits_two_circle_grains_with_their_elongation() {
             );
             worst_t = worst_t.max((fit.t - g.t).abs());
             worst_fit = worst_fit.max(fit.error);
-            assert!((fit.t - g.t).abs() < 0.1, "t {} fitted as {}", g.t, fit.t);
-            assert!(fit.error < 0.1, "fit error {}", fit.error);
+            // Measured: worst |t error| 0.018, worst fit error 0.017 (48 grains, seed 7).
+            assert!((fit.t - g.t).abs() < 0.036, "t {} fitted as {}", g.t, fit.t);
+            assert!(fit.error < 0.034, "fit error {}", fit.error);
         } else if g.t == 0.0 {
             n_disk += 1;
             assert_eq!(
