@@ -3,10 +3,11 @@
 # (default 1,000,000), in release, one target at a time, printing per target the executions,
 # wall time, accepted/refused counts and the peak memory of one execution.
 #   scripts/fuzz.sh [N] [TARGET...]      e.g. scripts/fuzz.sh 1000000 tiff scene_toml
-# LBDEM_FUZZ_SEED=K changes the mutation sequence (default 17, the one CI runs).
+# LBDEM_FUZZ_SEED=K changes the mutation sequence (default 17, the one CI runs);
+# LBDEM_FUZZ_DUMP=FILE keeps the input being executed in FILE (after a hang, the culprit).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 n="${1:-1000000}"
 shift || true
 export LBDEM_FUZZ_EXECS="$n"
-cargo test --release --test fuzz -- --nocapture --test-threads 1 "$@" 2>&1 | grep -oE "fuzz [a-z_]+: .*|test result.*|panicked.*|FAILED.*"
+cargo test --release --test fuzz -- --nocapture --test-threads 1 "$@" 2>&1 | grep --line-buffered -oE "fuzz [a-z_]+: .*|test result.*|panicked.*|FAILED.*"

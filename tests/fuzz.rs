@@ -271,8 +271,14 @@ fn fuzz(name: &str, ci: u32, seeds: Vec<Vec<u8>>, bound: fn(usize) -> usize, tar
     let (accepted, refused, worst) = (AtomicUsize::new(0), AtomicUsize::new(0), AtomicUsize::new(0));
     let t0 = Instant::now();
     let strategy = (0..seeds.len(), proptest::collection::vec(op(), 1..6));
+    // LBDEM_FUZZ_DUMP=FILE keeps the input being executed in FILE: after a hang (a run stopped
+    // by `timeout`), FILE holds the input that hung.
+    let dump = std::env::var_os("LBDEM_FUZZ_DUMP");
     let result = runner.run(&strategy, |(s, ops)| {
         let input = apply(&seeds[s], &ops);
+        if let Some(f) = &dump {
+            std::fs::write(f, &input).expect("LBDEM_FUZZ_DUMP: the file cannot be written");
+        }
         let base = CURRENT.load(Ordering::Relaxed);
         PEAK.store(base, Ordering::Relaxed);
         let ok = target(&input);

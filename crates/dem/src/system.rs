@@ -181,6 +181,21 @@ impl System {
         if !(positive(&b.mass) && positive(&b.inertia) && positive(&b.circle_r)) {
             return Err("a mass, inertia or circle radius is not positive and finite".into());
         }
+        let (lo, hi) = (self.domain.lo, self.domain.hi);
+        if !(finite2(&[lo, hi]) && hi.x > lo.x && hi.y > lo.y) {
+            return Err("the domain's corners are not finite or not ordered (lo < hi)".into());
+        }
+        // A clump's circle cannot reach farther from its body than the box is wide: a damaged
+        // offset of 2^32 m once made the solid-fraction pass of a coupled run loop for minutes.
+        let span = (hi - lo).norm();
+        if let Some(c) = (0..nc).find(|&c| b.circle_offset[c].norm() + b.circle_r[c] > span) {
+            return Err(format!(
+                "circle {c} reaches {:.3e} m from its body (offset {:.3e} m, radius {:.3e} m), beyond the domain's diagonal {span:.3e} m",
+                b.circle_offset[c].norm() + b.circle_r[c],
+                b.circle_offset[c].norm(),
+                b.circle_r[c]
+            ));
+        }
         if !(self.time.is_finite() && self.time >= 0.0) {
             return Err(format!(
                 "time = {} is not a finite, non-negative number",

@@ -209,3 +209,16 @@ fn clumps_with_walls_identical_for_one_and_two_threads() {
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.contacts, b.contacts);
 }
+
+/// A checkpoint whose clump circle sits 2^32 m from its body (found by the `checkpoint_coupled`
+/// fuzz harness, where it made the coupled solid-fraction pass loop for minutes) is refused by
+/// `check_state`, naming the circle; the undamaged state passes.
+#[test]
+fn a_circle_beyond_the_domain_is_refused() {
+    let s = generate::bidisperse_lattice(4, 1.0, 1.4, 1.42, 11).unwrap();
+    assert_eq!(s.check_state(), Ok(()));
+    let mut bad = s.clone();
+    bad.bodies.circle_offset[3].x = 4294967296.0;
+    let err = bad.check_state().unwrap_err();
+    assert!(err.contains("circle 3") && err.contains("diagonal"), "{err}");
+}
