@@ -5,6 +5,7 @@
 #   scripts/fuzz.sh [N] [TARGET...]      e.g. scripts/fuzz.sh 1000000 tiff scene_toml
 # LBDEM_FUZZ_SEED=K changes the mutation sequence (default 17, the one CI runs);
 # LBDEM_FUZZ_DUMP=FILE keeps the input being executed in FILE (after a hang, the culprit).
+# LBDEM_FUZZ_TIMEOUT_S=S fails a harness whose execution runs longer than S seconds (default 60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 n="${1:-1000000}"
