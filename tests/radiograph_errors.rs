@@ -1,5 +1,7 @@
 //! Bad input gets a clear error that names the file or parameter, and nothing is written.
 
+mod common;
+
 use lbdem::contract::{Stage, StageContext};
 use lbdem::io::tiff::{write_u8, write_u16};
 use lbdem::stages::radiograph::{Params, Radiograph};
@@ -185,17 +187,8 @@ fn a_header_claiming_80_gb_is_refused_without_allocating() {
     )
     .unwrap();
     let out = d.path().join("out");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lbdem"))
-        .args(["radiograph", "p.toml", "--out", "out"])
-        .current_dir(d.path())
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(
-        o.status.code(),
-        Some(1),
-        "a refused file exits 1, not abort: {err}"
-    );
+    let (code, err) = common::run_code(Some(d.path()), &["radiograph", "p.toml", "--out", "out"]);
+    assert_eq!(code, Some(1), "a refused file exits 1, not abort: {err}");
     for needle in ["huge.tif", "200000 x 200000", "limit", "128 MiB"] {
         assert!(err.contains(needle), "the error should name '{needle}': {err}");
     }

@@ -235,13 +235,9 @@ fn a_damaged_dry_checkpoint_is_refused_not_panicked() {
         .expect("a dry checkpoint holds the clumps' circle ranges");
     starts.pop();
     std::fs::write(&ck, serde_json::to_vec(&v).unwrap()).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_lbdem"))
-        .args(["simulate", p, "--out", b.to_str().unwrap(), "--resume"])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
+    let (code, err) = common::run_code(None, &["simulate", p, "--out", b.to_str().unwrap(), "--resume"]);
     assert_eq!(
-        o.status.code(),
+        code,
         Some(1),
         "refused with exit code 1, not a panic (101): {err}"
     );
