@@ -71,95 +71,65 @@ pub fn bad_scalar<T: Real, const B: usize>(rho: &[T; B], usq: &[T; B], lo: T, hi
     bits
 }
 
-impl Real for f64 {
-    const NAME: &'static str = "f64";
-    #[inline(always)]
-    fn step_two<L: Lattice>(
-        st: &mut Stepper<L, Self>,
-        fluid: &mut Fluid<L, Self>,
-        out: Option<&mut Macro>,
-    ) -> Result<(), LbmError> {
-        L::step_two_f64(st, fluid, out)
-    }
-    #[inline(always)]
-    fn step_aa<L: Lattice>(
-        st: &mut StepperAa<L, Self>,
-        fluid: &mut Fluid<L, Self>,
-        out: Option<&mut Macro>,
-    ) -> Result<(), LbmError> {
-        L::step_aa_f64(st, fluid, out)
-    }
-    #[inline(always)]
-    fn from_f64(x: f64) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self
-    }
-    #[inline(always)]
-    fn mul_add(self, a: Self, b: Self) -> Self {
-        f64::mul_add(self, a, b)
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-    #[inline(always)]
-    fn bad_block<const B: usize>(rho: &[Self; B], usq: &[Self; B], lo: Self, hi: Self, um: Self) -> u32 {
-        #[cfg(target_arch = "x86_64")]
-        if avx512() {
-            // SAFETY: the CPU has AVX-512F (`avx512`).
-            return unsafe { v4::bad_block_f64(rho, usq, lo, hi, um) };
+/// The two precisions differ only in which compiled kernels they forward to (`compiled.rs`
+/// instantiates each once) and which AVX-512 range check they use.
+macro_rules! real_impl {
+    ($t:ident, $step_two:ident, $step_aa:ident, $bad_block:ident) => {
+        impl Real for $t {
+            const NAME: &'static str = stringify!($t);
+            #[inline(always)]
+            fn step_two<L: Lattice>(
+                st: &mut Stepper<L, Self>,
+                fluid: &mut Fluid<L, Self>,
+                out: Option<&mut Macro>,
+            ) -> Result<(), LbmError> {
+                L::$step_two(st, fluid, out)
+            }
+            #[inline(always)]
+            fn step_aa<L: Lattice>(
+                st: &mut StepperAa<L, Self>,
+                fluid: &mut Fluid<L, Self>,
+                out: Option<&mut Macro>,
+            ) -> Result<(), LbmError> {
+                L::$step_aa(st, fluid, out)
+            }
+            #[inline(always)]
+            fn from_f64(x: f64) -> Self {
+                x as $t
+            }
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline(always)]
+            fn mul_add(self, a: Self, b: Self) -> Self {
+                $t::mul_add(self, a, b)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $t::sqrt(self)
+            }
+            #[inline(always)]
+            fn bad_block<const B: usize>(
+                rho: &[Self; B],
+                usq: &[Self; B],
+                lo: Self,
+                hi: Self,
+                um: Self,
+            ) -> u32 {
+                #[cfg(target_arch = "x86_64")]
+                if avx512() {
+                    // SAFETY: the CPU has AVX-512F (`avx512`).
+                    return unsafe { v4::$bad_block(rho, usq, lo, hi, um) };
+                }
+                bad_scalar(rho, usq, lo, hi, um)
+            }
         }
-        bad_scalar(rho, usq, lo, hi, um)
-    }
+    };
 }
 
-impl Real for f32 {
-    const NAME: &'static str = "f32";
-    #[inline(always)]
-    fn step_two<L: Lattice>(
-        st: &mut Stepper<L, Self>,
-        fluid: &mut Fluid<L, Self>,
-        out: Option<&mut Macro>,
-    ) -> Result<(), LbmError> {
-        L::step_two_f32(st, fluid, out)
-    }
-    #[inline(always)]
-    fn step_aa<L: Lattice>(
-        st: &mut StepperAa<L, Self>,
-        fluid: &mut Fluid<L, Self>,
-        out: Option<&mut Macro>,
-    ) -> Result<(), LbmError> {
-        L::step_aa_f32(st, fluid, out)
-    }
-    #[inline(always)]
-    fn from_f64(x: f64) -> Self {
-        x as f32
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
-    #[inline(always)]
-    fn mul_add(self, a: Self, b: Self) -> Self {
-        f32::mul_add(self, a, b)
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f32::sqrt(self)
-    }
-    #[inline(always)]
-    fn bad_block<const B: usize>(rho: &[Self; B], usq: &[Self; B], lo: Self, hi: Self, um: Self) -> u32 {
-        #[cfg(target_arch = "x86_64")]
-        if avx512() {
-            // SAFETY: the CPU has AVX-512F (`avx512`).
-            return unsafe { v4::bad_block_f32(rho, usq, lo, hi, um) };
-        }
-        bad_scalar(rho, usq, lo, hi, um)
-    }
-}
+real_impl!(f64, step_two_f64, step_aa_f64, bad_block_f64);
+real_impl!(f32, step_two_f32, step_aa_f32, bad_block_f32);
 
 /// Whether the AVX-512 range check may run: always in a `target-cpu=native` build for an
 /// AVX-512 CPU, else when `lbdem_core::simd` runs the kernels at that level (a `OnceLock` read
