@@ -148,7 +148,7 @@ fn time_stage(raw: &[Array2<u16>], reps: usize) -> Result<f64> {
         let mut names = Vec::new();
         for k in 0..8 {
             let name = format!("frame_{k:03}.tif");
-            crate::io::tiff::write_u16(&dir.join(&name), raw[k % raw.len()].view())?;
+            crate::io::tiff::write_u16_stack(&dir.join(&name), &[raw[k % raw.len()].view()])?;
             names.push(toml::Value::String(name));
         }
         let roi = |r: Roi| {

@@ -226,12 +226,13 @@ fn dims(f: &ArrayView2<f64>) -> Result<(u32, u32)> {
 pub fn write_f32(path: &Path, f: ArrayView2<f64>) -> Result<()> {
     let (w, h) = dims(&f)?;
     let v: Vec<f32> = f.iter().map(|&x| x as f32).collect();
-    let mut buf = Cursor::new(Vec::with_capacity(v.len() * 4 + 1024));
-    TiffEncoder::new(&mut buf)?
-        .write_image::<colortype::Gray32Float>(w, h, &v)
-        .with_context(|| format!("cannot encode {}", path.display()))?;
-    lbdem_core::atomic::write_atomic(path, buf.get_ref())
-        .with_context(|| format!("cannot write {}", path.display()))
+    // Encoded straight into the file's buffered writer: no second copy of the map in memory.
+    lbdem_core::atomic::write_atomic_with(path, |out| {
+        TiffEncoder::new(out)
+            .and_then(|mut e| e.write_image::<colortype::Gray32Float>(w, h, &v))
+            .map_err(std::io::Error::other)
+    })
+    .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// 16-bit unsigned TIFF, deflate-compressed, written atomically.
