@@ -8,6 +8,10 @@
 # LBDEM_FUZZ_TIMEOUT_S=S fails a harness whose execution runs longer than S seconds (default 60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+case "${1:-}" in
+  -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+  -*|*[!0-9]*) [ -n "${1:-}" ] && { echo "fuzz.sh: the first argument is the number of executions, not '$1' (see --help)" >&2; exit 2; } ;;
+esac
 n="${1:-1000000}"
 shift || true
 export LBDEM_FUZZ_EXECS="$n"

@@ -11,7 +11,8 @@
 #
 # One line per validation below: crate | test file (or lib) | test name | figure | reference | tolerance.
 # A new ignored validation gets a line here (tests/self_contained.rs checks that every ignored
-# test of the workspace is listed, or named as an exploration in EXPLORATIONS).
+# test of the workspace is listed, or named as an exploration in EXPLORATIONS or a child process
+# in CHILDREN).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -40,12 +41,20 @@ lbdem-lbm|stability|explore_tau|
 lbdem-dem|shear_rheology|ci_case_against_smaller_step_and_stokes_number|
 lbdem-dem|extruder|explore_reduced_flow|
 '
+# Ignored tests that another test runs as a child process (the fuzz watchdog ends the process it
+# runs in): neither validations nor explorations, not run by this script.
+# shellcheck disable=SC2034
+CHILDREN='
+lbdem|fuzz|hang_probe|run by a_hanging_execution_fails_the_harness_and_leaves_its_input
+'
 
 list_only=0
 filters=()
 for a in "$@"; do
   case "$a" in
     --list) list_only=1 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+    -*) echo "validate-all.sh: unknown option $a (options: --list, --help; other arguments filter by name)" >&2; exit 2 ;;
     *) filters+=("$a") ;;
   esac
 done
