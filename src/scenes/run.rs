@@ -2,8 +2,10 @@
 //! observers its `[run]` and `[output]` ask for, and hand both to the one time loop.
 
 use super::models;
-use super::observers::{MassBalanced, Progress, Series, SlowerThan, Snapshots, Steady, WallClock, WallMoved};
-use super::schema::{Loaded, Physics, Scene, TriggerSpec, WallRef};
+use super::observers::{
+    self, MassBalanced, Progress, Series, Snapshots, Steady, StillOver, WallClock, WallMoved,
+};
+use super::schema::{Loaded, Physics, Scene, SlowerOver, SlowerThan, TriggerSpec, WallRef};
 use super::timeloop::{self, LoopCfg, Model, Observer, Probe, Trigger};
 use crate::contract::Table;
 use anyhow::{Context, Result};
@@ -91,11 +93,18 @@ pub fn observers(s: &Scene, total: u64) -> Result<(Vec<Box<dyn Observer>>, Trigg
         Box::new(Snapshots::new(trigger(s, "snapshots", &out.snapshots, total)?)),
     ];
     let r = &s.run;
-    if let Some(v) = r.until_slower_than {
-        obs.push(Box::new(SlowerThan {
+    match r.until_slower_than {
+        Some(SlowerThan::Speed(v)) => obs.push(Box::new(observers::SlowerThan {
             v,
             trigger: series.clone(),
-        }));
+        })),
+        Some(SlowerThan::Window(SlowerOver { speed, over })) => obs.push(Box::new(StillOver {
+            speed,
+            over,
+            trigger: series.clone(),
+            start: None,
+        })),
+        None => {}
     }
     if let Some(tol) = r.until_steady {
         obs.push(Box::new(Steady {

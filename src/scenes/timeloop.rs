@@ -31,6 +31,17 @@ pub trait Model {
     fn probe_needs_fields(&self, _q: Probe) -> bool {
         false
     }
+    /// Every grain's centroid (m), for stop conditions that compare positions over a time
+    /// window; `None` when the model has no grains.
+    fn grain_centroids(&self) -> Option<Vec<[f64; 2]>> {
+        None
+    }
+    /// The largest distance (m) a grain moved since `then` (taken by
+    /// [`Model::grain_centroids`]), across periodic faces; `None` without grains, or when the
+    /// grains are not the same ones.
+    fn max_grain_displacement(&self, _then: &[[f64; 2]]) -> Option<f64> {
+        None
+    }
     /// Write the current state under `dir` (tables that can be read back, VTK beside them);
     /// returns (kind, path relative to `dir`) of each file.
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>>;

@@ -374,6 +374,12 @@ impl<T: Real> Model for CoupledModel<T> {
         }
         v
     }
+    fn grain_centroids(&self) -> Option<Vec<[f64; 2]>> {
+        Some(super::centroids(&self.run.sys))
+    }
+    fn max_grain_displacement(&self, then: &[[f64; 2]]) -> Option<f64> {
+        super::max_displacement(&self.run.sys, then)
+    }
     fn probe(&self, q: Probe) -> Option<f64> {
         match q {
             Probe::MaxGrainSpeed => Some(self.run.sys.bodies.max_speed()),

@@ -158,6 +158,12 @@ impl Model for Dry {
         }
         v
     }
+    fn grain_centroids(&self) -> Option<Vec<[f64; 2]>> {
+        Some(super::centroids(&self.sys))
+    }
+    fn max_grain_displacement(&self, then: &[[f64; 2]]) -> Option<f64> {
+        super::max_displacement(&self.sys, then)
+    }
     fn probe(&self, q: Probe) -> Option<f64> {
         match q {
             Probe::MaxGrainSpeed => Some(self.sys.bodies.max_speed()),

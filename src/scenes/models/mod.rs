@@ -11,7 +11,7 @@ pub mod packed_zone;
 pub mod shear_cell;
 
 use crate::scenes::snapshot::ContactForce;
-use lbdem_dem::{Stepper, System};
+use lbdem_dem::{Stepper, System, Vector as _};
 
 /// The touching pairs of the last force evaluation, for the contact table.
 pub fn contact_list(st: &Stepper, sys: &System) -> Vec<ContactForce> {
@@ -22,6 +22,25 @@ pub fn contact_list(st: &Stepper, sys: &System) -> Vec<ContactForce> {
             force: [f.x, f.y],
         })
         .collect()
+}
+
+/// Every body's centroid, for [`crate::scenes::timeloop::Model::grain_centroids`].
+pub fn centroids(sys: &System) -> Vec<[f64; 2]> {
+    sys.bodies.pos.iter().map(|p| [p.x, p.y]).collect()
+}
+
+/// The largest distance a body moved since `then` (from [`centroids`]), the minimum image on
+/// periodic axes (a window is short against the time to cross a box); `None` when the bodies
+/// are not the same number.
+pub fn max_displacement(sys: &System, then: &[[f64; 2]]) -> Option<f64> {
+    (then.len() == sys.bodies.len()).then(|| {
+        sys.bodies
+            .pos
+            .iter()
+            .zip(then)
+            .map(|(p, &[x, y])| sys.domain.min_image(*p - lbdem_dem::Vec2::new(x, y)).norm())
+            .fold(0.0, f64::max)
+    })
 }
 
 /// The grains of the scene as the DEM steps them: `build_system`, then `[particles]

@@ -31,6 +31,59 @@ impl Observer for SlowerThan {
     }
 }
 
+/// Stop at the end of the first window of `over` seconds in which no grain moved more than
+/// `speed` × the window (`until_slower_than = { speed, over }`; Su et al. 2020 Sect. 3.2: still
+/// on the radiographs = under 2 µm in 10 s). Windows follow one another, each starting where the
+/// last was judged, so the stop comes at most two windows after the grains stilled; the window's
+/// start (its time and every centroid) is checkpointed, so a resumed run stops at the same step.
+pub struct StillOver {
+    pub speed: f64,
+    pub over: f64,
+    pub trigger: Trigger,
+    pub start: Option<(f64, Vec<[f64; 2]>)>,
+}
+
+impl Observer for StillOver {
+    fn name(&self) -> &'static str {
+        "until_slower_than_over"
+    }
+    fn trigger(&self) -> &Trigger {
+        &self.trigger
+    }
+    fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
+        let t = m.time();
+        // A window ends after `over` s, less a step's rounding.
+        let ended = match &self.start {
+            None => true,
+            Some((t0, then)) if t - t0 >= self.over - 0.5 * m.dt() => {
+                let limit = self.speed * (t - t0);
+                if let Some(moved) = m.max_grain_displacement(then).filter(|&d| d < limit) {
+                    return Ok(Flow::Stop(format!(
+                        "every grain moved less than {limit:.3e} m (at most {moved:.3e} m) in the {:.4} s to step {}: \
+                         slower than {:e} m/s on average",
+                        t - t0,
+                        m.steps_done(),
+                        self.speed
+                    )));
+                }
+                true
+            }
+            Some(_) => false,
+        };
+        if ended {
+            self.start = m.grain_centroids().map(|x| (t, x));
+        }
+        Ok(Flow::Continue)
+    }
+    fn save(&self) -> serde_json::Value {
+        serde_json::json!(self.start)
+    }
+    fn restore(&mut self, v: serde_json::Value) -> Result<()> {
+        self.start = serde_json::from_value(v)?;
+        Ok(())
+    }
+}
+
 /// Stop when the mean liquid speed changes by less than `tol` (relative) between two checks.
 pub struct Steady {
     pub tol: f64,

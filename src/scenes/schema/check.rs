@@ -301,6 +301,8 @@ const RULES: &[Rule] = &[
     ),
     Rule("run.time", Need::Positive, "simulated time (s)"),
     Rule("run.until_slower_than", Need::Positive, "speed (m/s)"),
+    Rule("run.until_slower_than.speed", Need::Positive, "speed (m/s)"),
+    Rule("run.until_slower_than.over", Need::Positive, "window (s; Su: 10)"),
     Rule("run.until_steady", Need::Positive, "relative change"),
     Rule("run.until_wall_moved.distance", Need::Positive, "distance (m)"),
     Rule("run.wall_clock", Need::Positive, "wall-clock limit (s)"),

@@ -30,7 +30,7 @@ pub use fluid::{
     ObstacleSection,
 };
 pub use packed_zone::PackedZoneSection;
-pub use run::{OutputSection, RunSection, TriggerSpec, WallMoved, WallRef, When};
+pub use run::{OutputSection, RunSection, SlowerOver, SlowerThan, TriggerSpec, WallMoved, WallRef, When};
 pub use shear_cell::ShearCellSection;
 
 use anyhow::{Context, Result, bail};

@@ -14,9 +14,10 @@ pub struct RunSection {
     /// Simulated time (s).
     #[serde(default)]
     pub time: Option<f64>,
-    /// Stop when every grain is slower than this (m/s), checked at every series sample.
+    /// Stop when every grain is slower than a speed (m/s): instantaneously, checked at every
+    /// series sample, or as a displacement over a time window (`{ speed, over }`).
     #[serde(default)]
-    pub until_slower_than: Option<f64>,
+    pub until_slower_than: Option<SlowerThan>,
     /// Stop when the mean liquid speed changes by less than this fraction between series samples.
     #[serde(default)]
     pub until_steady: Option<f64>,
@@ -29,6 +30,34 @@ pub struct RunSection {
     /// rayon threads (0 = all cores). Results do not depend on it.
     #[serde(default)]
     pub threads: usize,
+}
+
+/// `until_slower_than = 1e-7` stops at the first series sample at which every grain's speed is
+/// below 1e-7 m/s. `until_slower_than = { speed = 1e-7, over = 10.0 }` stops at the end of the
+/// first window of `over` seconds (windows follow one another from the start, checked at the
+/// series samples) in which no grain moved more than `speed` × the window: Su et al. 2020 read
+/// still grains off the radiographs this way (Sect. 3.2, under 2 µm in 10 s), and a packed layer
+/// of elastic grains, whose rattlers vibrate in place faster than 1e-7 m/s for ever, ends only
+/// under this form.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(
+    untagged,
+    expecting = "a speed in m/s (until_slower_than = 1e-7) or a speed over a window \
+                 (until_slower_than = { speed = 1e-7, over = 10.0 }, m/s and s)"
+)]
+pub enum SlowerThan {
+    Speed(f64),
+    Window(SlowerOver),
+}
+
+/// The windowed form of [`SlowerThan`].
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SlowerOver {
+    /// Mean speed over the window (m/s).
+    pub speed: f64,
+    /// Window (s).
+    pub over: f64,
 }
 
 /// `until_wall_moved = { wall = "plate", distance = 1e-3 }`: the wall by its `name` in

@@ -260,3 +260,18 @@ fn every_shipped_scene_passes_the_value_checks() {
     // 26 on 2026-11-24 (scenes/ and scenes/su2020/ less the files others extend).
     assert!(loaded >= 26, "only {loaded} scenes loaded");
 }
+
+/// The windowed stop (`until_slower_than = { speed, over }`): a window that is not positive, a
+/// missing key or an unknown one is refused by name before anything runs.
+#[test]
+fn a_stop_window_of_zero_or_a_malformed_one_is_refused() {
+    let with = |v: &str| dry_with("steps = 3000", &format!("steps = 3000\nuntil_slower_than = {v}"));
+    let m = refused(&with("{ speed = 1.0e-7, over = 0.0 }"), None);
+    contains_all(&m, &["until_slower_than.over = 0.0", "must be above 0"]);
+    let m = refused(&with("{ speed = -1.0e-7, over = 10.0 }"), None);
+    contains_all(&m, &["until_slower_than.speed = -1e-7", "must be above 0"]);
+    for bad in ["{ speed = 1.0e-7 }", "{ speed = 1.0e-7, over = 10.0, extra = 1 }"] {
+        let m = refused(&with(bad), None);
+        contains_all(&m, &["until_slower_than", "over = 10.0"]);
+    }
+}

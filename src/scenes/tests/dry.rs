@@ -173,3 +173,72 @@ fn snapshots_when_the_plate_has_moved_and_stop_at_a_distance() {
     let e = format!("{:#}", simulate(&bad, &t.path().join("bad"), false).unwrap_err());
     assert!(e.contains("\"plates\"") && e.contains("plate"), "{e}");
 }
+
+/// `until_slower_than = { speed, over }` (Su et al. 2020 Sect. 3.2's radiograph criterion, the
+/// Float case's stop): the run stops at the end of the first window in which no grain moved more
+/// than speed × window, and not a window earlier. Checked against the same scene run without the
+/// stop to the same step (the runs are deterministic), whose snapshots give the grains'
+/// displacements over the last two windows; and a run interrupted again and again stops at the
+/// same step with the same bits (the window's start is checkpointed).
+#[test]
+fn the_windowed_stop_ends_at_the_first_still_window_and_resumes_to_the_same_bits() {
+    let t = tempfile::tempdir().unwrap();
+    let still = SCENE
+        .replace(
+            "steps = 3000",
+            "time = 2.0\nuntil_slower_than = { speed = 1.0e-4, over = 0.02 }",
+        )
+        .replace("series = { every = 100 }", "series = { every = 500 }")
+        .replace("snapshots = { every = 1000 }", "snapshots = { every = 100000 }");
+    let rec = simulate(&still, &t.path().join("still"), false).unwrap();
+    let s = &rec.output.summary;
+    let why = s["stopped"].as_str().unwrap_or("");
+    assert!(why.contains("every grain moved less than"), "{s}");
+    // Windows of 5000 steps from the first series sample (step 500); measured: step 30 500.
+    let stop = s["steps"].as_u64().unwrap();
+    assert!(stop < 500_000 && (stop - 500).is_multiple_of(5000), "{s}");
+    let (window, limit) = (5000, 1.0e-4 * 0.02);
+    let plain = still
+        .replace(
+            "time = 2.0\nuntil_slower_than = { speed = 1.0e-4, over = 0.02 }",
+            &format!("steps = {stop}"),
+        )
+        .replace("snapshots = { every = 100000 }", "snapshots = { every = 500 }");
+    simulate(&plain, &t.path().join("plain"), false).unwrap();
+    let at = |step: u64| {
+        crate::scenes::snapshot::read_particles(
+            &t.path()
+                .join(format!("plain/out/snapshots/particles_{step:09}.csv")),
+        )
+        .unwrap()
+    };
+    let moved = |a: u64, b: u64| {
+        let (p, q) = (at(a), at(b));
+        (0..p.body_x.len())
+            .map(|k| (q.body_x[k] - p.body_x[k]).hypot(q.body_y[k] - p.body_y[k]))
+            .fold(0.0, f64::max)
+    };
+    let (last, before) = (
+        moved(stop - window, stop),
+        moved(stop - 2 * window, stop - window),
+    );
+    assert!(last < limit, "the last window moved {last:e} m (limit {limit:e})");
+    assert!(
+        before >= limit,
+        "the window before moved {before:e} m: it should have stopped then"
+    );
+    // Interrupted every 0.05 s of wall time and resumed: the same stop, the same bits.
+    let limited = still.replace("time = 2.0", "time = 2.0\nwall_clock = 0.05");
+    let cut = t.path().join("cut");
+    let interruptions = resume_until_done(&limited, &cut, 10_000);
+    for f in [
+        "series.csv".to_string(),
+        format!("snapshots/particles_{stop:09}.csv"),
+    ] {
+        let (x, y) = (
+            std::fs::read(t.path().join("still/out").join(&f)).unwrap(),
+            std::fs::read(cut.join("out").join(&f)).unwrap(),
+        );
+        assert!(x == y, "{f} differs after {interruptions} interruptions");
+    }
+}
