@@ -2,6 +2,7 @@
 //! dash-dot as in Su et al. (2020) Fig. 6, markers for discrete points, and labelled horizontal
 //! or vertical reference lines (a threshold such as Δp_c, a displacement such as 10 d̄).
 
+use super::legend;
 use super::plot::{FONT, SERIES_COLOURS, de, finite_range, render_png};
 use anyhow::{Result, bail};
 use plotters::prelude::*;
@@ -89,6 +90,26 @@ pub fn lines_png(path: &Path, lines: &[Line], opts: &LinesPlot) -> Result<()> {
     };
     let (x0, x1) = padded(x0, x1, opts.log_x);
     let (y0, y1) = opts.y_range.unwrap_or_else(|| padded(y0, y1, opts.log_y));
+    let labels = lines
+        .iter()
+        .map(|l| l.label)
+        .chain(opts.h_refs.iter().chain(&opts.v_refs).map(|r| r.label))
+        .filter(|l| !l.is_empty());
+    let corner = legend::quietest_corner(
+        &legend::Frame {
+            x: (x0, x1),
+            y: (y0, y1),
+            log_x: opts.log_x,
+            log_y: opts.log_y,
+            entries: labels.clone().count(),
+            longest: labels.map(|l| l.chars().count()).max().unwrap_or(0),
+            area_px: (695.0, 460.0),
+        },
+        lines
+            .iter()
+            .flat_map(|l| l.x.iter().copied().zip(l.y.iter().copied())),
+        &opts.h_refs.iter().map(|r| r.value).collect::<Vec<_>>(),
+    );
     render_png(path, (800, 560), None, |root| {
         root.fill(&WHITE).map_err(de)?;
         let mut b = ChartBuilder::on(root);
@@ -182,7 +203,7 @@ pub fn lines_png(path: &Path, lines: &[Line], opts: &LinesPlot) -> Result<()> {
                 {
                     chart
                         .configure_series_labels()
-                        .position(SeriesLabelPosition::UpperRight)
+                        .position(corner.clone())
                         .background_style(WHITE.mix(0.85))
                         .border_style(BLACK)
                         .label_font((FONT, 13))

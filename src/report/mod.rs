@@ -2,6 +2,7 @@
 //! tables (polars, eager) and the HTML page with its provenance block.
 
 pub mod grid_map;
+pub mod legend;
 pub mod lines;
 pub mod mechanism_map;
 pub mod panels;

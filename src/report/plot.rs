@@ -319,6 +319,22 @@ pub fn xy_png(path: &Path, series: &[Series], opts: &XyPlot) -> Result<()> {
     };
     let (x0, x1) = padded(x0, x1, opts.log_x);
     let (y0, y1) = padded(y0, y1, opts.log_y);
+    let labels = series.iter().map(|s| s.label).filter(|l| !l.is_empty());
+    let corner = super::legend::quietest_corner(
+        &super::legend::Frame {
+            x: (x0, x1),
+            y: (y0, y1),
+            log_x: opts.log_x,
+            log_y: opts.log_y,
+            entries: labels.clone().count(),
+            longest: labels.map(|l| l.chars().count()).max().unwrap_or(0),
+            area_px: (700.0, 460.0),
+        },
+        series
+            .iter()
+            .flat_map(|s| s.x.iter().copied().zip(s.y.iter().copied())),
+        &[],
+    );
     render_png(path, (800, 560), None, |root| {
         root.fill(&WHITE).map_err(de)?;
         let mut b = ChartBuilder::on(root);
@@ -365,6 +381,7 @@ pub fn xy_png(path: &Path, series: &[Series], opts: &XyPlot) -> Result<()> {
                 if series.iter().any(|s| !s.label.is_empty()) {
                     chart
                         .configure_series_labels()
+                        .position(corner.clone())
                         .background_style(WHITE.mix(0.85))
                         .border_style(BLACK)
                         .label_font((FONT, 13))
