@@ -211,3 +211,39 @@ fn a_header_claiming_80_gb_is_refused_without_allocating() {
         lbdem::io::tiff::read_pages_from(std::io::Cursor::new(hostile_tiff(4096, 4096)), "x").unwrap_err();
     assert!(format!("{e:#}").contains("cannot decode the pixel data"), "{e:#}");
 }
+
+/// Frames are read one at a time while earlier ones are processed (issue 18 item 5), so a pixel
+/// that is not positive in a later frame is found after the first maps were made: the stage
+/// still fails naming that frame and pixel, and through `lbdem radiograph` (the pipeline's
+/// staging directory) nothing is left behind. With `mask_nonpositive` the same frames run and
+/// the pixel is counted as masked.
+#[test]
+fn a_bad_pixel_in_a_later_frame_fails_the_run_and_leaves_nothing() {
+    let d = setup();
+    let mut bad = frame(64, 64, 19000);
+    bad[[5, 7]] = 0;
+    write_u16(&d.path().join("c.tif"), bad.view()).unwrap();
+    let base = "frames = [\"a.tif\", \"b.tif\", \"c.tif\"]\ni_s0_roi = [0, 0, 16, 16]\n\
+                i_l0_roi = [40, 0, 16, 16]\nmu_s = 2000.0\nmu_l = 9000.0\nl_alloy0 = 150e-6\n\
+                d_bar = 10e-6\npixel_size = 1e-6\nplots = false\n";
+    std::fs::write(d.path().join("p.toml"), base).unwrap();
+    let (code, err) = common::run_code(Some(d.path()), &["radiograph", "p.toml", "--out", "out"]);
+    assert_eq!(code, Some(1), "{err}");
+    for needle in ["c.tif", "not positive", "row 5, col 7"] {
+        assert!(err.contains(needle), "the error should name '{needle}': {err}");
+    }
+    assert!(!d.path().join("out").exists(), "nothing may be left behind");
+    std::fs::write(
+        d.path().join("m.toml"),
+        format!("{base}mask_nonpositive = true\n"),
+    )
+    .unwrap();
+    let (code, err) = common::run_code(Some(d.path()), &["radiograph", "m.toml", "--out", "out"]);
+    assert_eq!(code, Some(0), "{err}");
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.path().join("out/summary.json")).unwrap()).unwrap();
+    let masked: Vec<u64> = (0..3)
+        .map(|n| s["per_frame"][n]["masked_pixels"].as_u64().unwrap())
+        .collect();
+    assert_eq!(masked, [0, 0, 1]);
+}

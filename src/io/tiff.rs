@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::encoder::{Compression, DeflateLevel, TiffEncoder, colortype};
+use tiff::tags::Tag;
 
 /// One frame read from a file: which file and page, and its pixels.
 #[derive(Clone, Debug)]
@@ -44,35 +45,137 @@ fn limits() -> Limits {
 
 /// Every TIFF page of `path` (a stack yields several frames).
 pub fn read_pages(path: &Path) -> Result<Vec<Frame>> {
+    pages(path)?.map(|p| p.map(Page::into_frame)).collect()
+}
+
+fn open(path: &Path) -> Result<std::io::BufReader<std::fs::File>> {
     let file = std::fs::File::open(path).with_context(|| {
         format!(
             "cannot open TIFF file {} (check the path in 'frames'/'dark'/'flat')",
             path.display()
         )
     })?;
-    read_pages_from(std::io::BufReader::new(file), &path.display().to_string())
+    Ok(std::io::BufReader::new(file))
+}
+
+/// The pages of the TIFF file `path`, decoded one at a time as they are asked for.
+pub fn pages(path: &Path) -> Result<Pages<std::io::BufReader<std::fs::File>>> {
+    Pages::new(open(path)?, &path.display().to_string())
 }
 
 /// Every TIFF page of the bytes `r` yields, labelled `name` in errors (the file's path). Memory
 /// is bounded by [`MAX_FRAME_BYTES`] per page and [`MAX_FILE_PIXELS`] per file whatever the
 /// header claims; bad input is an error, never a panic or an abort.
 pub fn read_pages_from<R: Read + Seek>(r: R, name: &str) -> Result<Vec<Frame>> {
-    let mut dec = Decoder::new(r)
-        .with_context(|| format!("{name} is not a readable TIFF file"))?
-        .with_limits(limits());
-    let mut frames = Vec::new();
-    let mut pixels = 0u64;
+    Pages::new(r, name)?.map(|p| p.map(Page::into_frame)).collect()
+}
+
+/// A page's pixels as stored: 16-bit counts stay 16-bit (the radiograph stage reads them through
+/// a lookup table: no f64 copy of a 2048² frame), every other sample type becomes f64.
+#[derive(Clone, Debug)]
+pub enum Pixels {
+    U16(Array2<u16>),
+    F64(Array2<f64>),
+}
+
+impl Pixels {
+    /// (rows, columns).
+    pub fn dim(&self) -> (usize, usize) {
+        match self {
+            Pixels::U16(a) => a.dim(),
+            Pixels::F64(a) => a.dim(),
+        }
+    }
+    pub fn into_f64(self) -> Array2<f64> {
+        match self {
+            Pixels::U16(a) => a.mapv(f64::from),
+            Pixels::F64(a) => a,
+        }
+    }
+}
+
+/// One decoded page.
+#[derive(Clone, Debug)]
+pub struct Page {
+    /// As [`Frame::label`].
+    pub label: String,
+    pub bits: u8,
+    pub pixels: Pixels,
+}
+
+impl Page {
+    pub fn into_frame(self) -> Frame {
+        Frame {
+            label: self.label,
+            bits: self.bits,
+            data: self.pixels.into_f64(),
+        }
+    }
+}
+
+/// What a page's header says.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PageInfo {
+    pub label: String,
+    pub rows: usize,
+    pub cols: usize,
+    pub bits: u8,
+}
+
+/// The headers of every page of `path`, without decoding pixels: how many frames a stack holds
+/// and their sizes, checked before a stage reads the first frame.
+pub fn probe_pages(path: &Path) -> Result<Vec<PageInfo>> {
+    let mut p = pages(path)?;
+    let mut out = Vec::new();
     loop {
-        let page = frames.len();
-        let label = if page == 0 {
-            name.to_string()
+        out.push(p.header()?);
+        if !p.advance()? {
+            return Ok(out);
+        }
+    }
+}
+
+/// The pages of one TIFF file as an iterator: one page decoded per `next`, so a stack of
+/// hundreds of frames needs one frame's memory at a time. After an error it yields nothing.
+pub struct Pages<R: Read + Seek> {
+    dec: Decoder<R>,
+    name: String,
+    page: usize,
+    pixels: u64,
+    done: bool,
+}
+
+impl<R: Read + Seek> Pages<R> {
+    pub fn new(r: R, name: &str) -> Result<Self> {
+        let dec = Decoder::new(r)
+            .with_context(|| format!("{name} is not a readable TIFF file"))?
+            .with_limits(limits());
+        Ok(Self {
+            dec,
+            name: name.to_string(),
+            page: 0,
+            pixels: 0,
+            done: false,
+        })
+    }
+
+    fn label(&self) -> String {
+        if self.page == 0 {
+            self.name.clone()
         } else {
-            format!("{name}#{page}")
-        };
-        let (w, h) = dec
+            format!("{}#{}", self.name, self.page)
+        }
+    }
+
+    /// The current page's header, checked against the per-page and per-file limits.
+    fn header(&mut self) -> Result<PageInfo> {
+        let label = self.label();
+        let (w, h) = self
+            .dec
             .dimensions()
             .with_context(|| format!("{label}: cannot read the image size"))?;
-        let ct = dec
+        let ct = self
+            .dec
             .colortype()
             .with_context(|| format!("{label}: cannot read the pixel type"))?;
         let bits = match ct {
@@ -83,6 +186,29 @@ pub fn read_pages_from<R: Read + Seek>(r: R, name: &str) -> Result<Vec<Frame>> {
                  ImageJ or tifffile) to one of these"
             ),
         };
+        // The sample format from the header (absent = unsigned), so a stage that reads pixels
+        // later refuses a 32-bit integer frame before it writes anything.
+        let format = match self.dec.find_tag(Tag::SampleFormat) {
+            Ok(Some(v)) => v
+                .into_u32_vec()
+                .ok()
+                .and_then(|v| v.first().copied())
+                .unwrap_or(0),
+            Ok(None) => 1,
+            Err(_) => 0,
+        };
+        if !matches!((bits, format), (8 | 16, 1) | (32 | 64, 3)) {
+            bail!(
+                "{label}: unsupported {bits}-bit sample format ({bits}-bit {}); lbdem reads 8/16-bit unsigned \
+                 integer or 32-bit float samples",
+                match format {
+                    1 => "unsigned integer",
+                    2 => "signed integer",
+                    3 => "float",
+                    _ => "other",
+                }
+            );
+        }
         let bytes = u64::from(w) * u64::from(h) * u64::from(bits / 8);
         if bytes > MAX_FRAME_BYTES as u64 {
             bail!(
@@ -93,22 +219,65 @@ pub fn read_pages_from<R: Read + Seek>(r: R, name: &str) -> Result<Vec<Frame>> {
                 MAX_FRAME_BYTES >> 20
             );
         }
-        pixels += u64::from(w) * u64::from(h);
-        if pixels > MAX_FILE_PIXELS {
+        self.pixels += u64::from(w) * u64::from(h);
+        if self.pixels > MAX_FILE_PIXELS {
             bail!(
                 "{label}: the stack holds more than {MAX_FILE_PIXELS} pixels in {} pages, above lbdem's limit per \
                  file; split the stack into several files (a directory of frames is read in order)",
-                page + 1
+                self.page + 1
             );
         }
-        let img = dec
+        Ok(PageInfo {
+            label,
+            rows: h as usize,
+            cols: w as usize,
+            bits,
+        })
+    }
+
+    /// Move to the next page; false after the last.
+    fn advance(&mut self) -> Result<bool> {
+        if !self.dec.more_images() {
+            return Ok(false);
+        }
+        self.dec
+            .next_image()
+            .with_context(|| format!("{}: cannot read page {}", self.name, self.page + 1))?;
+        self.page += 1;
+        Ok(true)
+    }
+
+    fn decode(&mut self) -> Result<Page> {
+        let PageInfo {
+            label,
+            rows,
+            cols,
+            bits,
+        } = self.header()?;
+        let img = self
+            .dec
             .read_image()
             .with_context(|| format!("{label}: cannot decode the pixel data"))?;
-        let v: Vec<f64> = match img {
-            DecodingResult::U8(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::U16(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::F32(v) => v.into_iter().map(f64::from).collect(),
-            DecodingResult::F64(v) => v,
+        let shaped = |n: usize| {
+            if n == rows * cols {
+                Ok((rows, cols))
+            } else {
+                Err(anyhow::anyhow!(
+                    "{label}: pixel count does not match {cols}x{rows}"
+                ))
+            }
+        };
+        let pixels = match img {
+            DecodingResult::U16(v) => Pixels::U16(Array2::from_shape_vec(shaped(v.len())?, v)?),
+            DecodingResult::U8(v) => Pixels::F64(Array2::from_shape_vec(
+                shaped(v.len())?,
+                v.into_iter().map(f64::from).collect(),
+            )?),
+            DecodingResult::F32(v) => Pixels::F64(Array2::from_shape_vec(
+                shaped(v.len())?,
+                v.into_iter().map(f64::from).collect(),
+            )?),
+            DecodingResult::F64(v) => Pixels::F64(Array2::from_shape_vec(shaped(v.len())?, v)?),
             other => bail!(
                 "{label}: unsupported {bits}-bit sample format ({}); lbdem reads 8/16-bit unsigned integer \
                  or 32-bit float samples",
@@ -120,16 +289,23 @@ pub fn read_pages_from<R: Read + Seek>(r: R, name: &str) -> Result<Vec<Frame>> {
                 }
             ),
         };
-        let data = Array2::from_shape_vec((h as usize, w as usize), v)
-            .with_context(|| format!("{label}: pixel count does not match {w}x{h}"))?;
-        frames.push(Frame { label, data, bits });
-        if !dec.more_images() {
-            break;
-        }
-        dec.next_image()
-            .with_context(|| format!("{name}: cannot read page {}", page + 1))?;
+        Ok(Page { label, bits, pixels })
     }
-    Ok(frames)
+}
+
+impl<R: Read + Seek> Iterator for Pages<R> {
+    type Item = Result<Page>;
+    fn next(&mut self) -> Option<Result<Page>> {
+        if self.done {
+            return None;
+        }
+        let page = self.decode().and_then(|p| {
+            self.done = !self.advance()?;
+            Ok(p)
+        });
+        self.done |= page.is_err();
+        Some(page)
+    }
 }
 
 /// Expand the `frames` list: a directory becomes its `*.tif`/`*.tiff` files in natural

@@ -2,9 +2,12 @@
 //! volumetric strain (Su et al. 2020, Sect. 2.2, Eqs. 1-5), ROI profiles and the meniscus
 //! line scan (Eqs. 2, 22, 23). Frame 0 is the reference (undeformed) frame.
 //!
-//! Everything that can be wrong with the input (files, sizes, bit depths, ROIs, reference
-//! intensities, positivity, REV size, thickness) is checked before the first file is
-//! written; then frames are processed one by one and written.
+//! Everything that can be wrong with the input files' headers and the parameters (files, frame
+//! count, sizes, sample types, ROIs, reference intensities, REV size) and with frame 0 is
+//! checked before the first file is written. The later frames are then read, corrected and
+//! processed one at a time, the next one read while the current one is processed, so a frame's
+//! own pixels (not positive, a thickness that is not) can fail the run part-way: the pipeline
+//! runs every stage in a staging directory that is removed on failure, so nothing is left.
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::io::tiff as tio;
@@ -218,30 +221,204 @@ impl Stage for Radiograph {
     }
     fn run(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         let prepared = prepare(p, ctx)?;
-        write_outputs(p, ctx, &prepared)
+        write_outputs(p, ctx, prepared)
     }
 }
 
-/// Everything validated and corrected, ready to process and write.
+/// Everything validated, frame 0 read and corrected and the references found; the later
+/// frames are read and corrected one at a time on a thread of their own while the frame before
+/// is processed ([`FrameSource`]), so a sequence of any length needs a few frames' memory (all
+/// frames were held as f64 before: 32 MB per 2048² frame, 16 GB for 500 frames) and reading is
+/// overlapped with the REV passes (issue 18 item 5).
 pub struct Prepared {
+    /// Every frame's label (`file` or `file#page`), from the headers.
     pub labels: Vec<String>,
-    /// Corrected intensities (NaN = masked).
-    pub intensity: Vec<Array2<f64>>,
+    /// (rows, columns) of every frame.
+    pub shape: (usize, usize),
     pub rev_side: usize,
     pub i_l0: f64,
     pub i_s0: f64,
-    /// `L_alloy^n` of every frame, m.
-    pub thickness: Vec<f64>,
-    pub maps: Vec<FractionMap>,
-    pub gamma_replaced: Vec<usize>,
-    pub dose: Vec<f64>,
-    pub masked: Vec<usize>,
+    /// Frame 0's mean corrected intensity over `thickness_roi` (NaN without one).
+    troi0: f64,
+    /// Eq. (1a) of frame 0.
+    map0: FractionMap,
     pub warnings: Vec<String>,
     /// The bulk-phase rule of `edge_flag`, if enabled.
     pub bulk: Option<BulkPhase>,
-    /// Every frame is 16-bit counts that no correction changed (no dark, flat, gamma spots or
-    /// dose normalisation): the intensities are integers in 0..=65535.
+    /// Every frame is 16-bit counts that no correction changes (no dark, flat, gamma spots or
+    /// dose normalisation): frames stay 16-bit and go through a lookup table.
     pub counts: bool,
+    /// Frame 0, corrected.
+    first: Corrected,
+    /// The frames after it, still to be read.
+    source: FrameSource,
+    dark: Option<Array2<f64>>,
+    flat: Option<Array2<f64>>,
+}
+
+/// One frame after correction.
+struct Corrected {
+    label: String,
+    /// The frame as 16-bit counts (a count of 0 is masked), when no correction changes them...
+    counts: Option<Array2<u16>>,
+    /// ...else its corrected intensity (NaN = masked).
+    intensity: Option<Array2<f64>>,
+    gamma_replaced: usize,
+    dose: f64,
+    masked: usize,
+}
+
+impl Corrected {
+    /// The intensity as f64 (counts of 0 as NaN), borrowed when there is one.
+    fn intensity(&self) -> std::borrow::Cow<'_, Array2<f64>> {
+        match (&self.intensity, &self.counts) {
+            (Some(i), _) => std::borrow::Cow::Borrowed(i),
+            (None, Some(c)) => {
+                std::borrow::Cow::Owned(c.mapv(|v| if v == 0 { f64::NAN } else { f64::from(v) }))
+            }
+            (None, None) => unreachable!("a corrected frame holds counts or an intensity"),
+        }
+    }
+
+    /// Mean intensity over `roi` (masked pixels left out), without converting the whole frame.
+    fn roi_mean(&self, name: &str, roi: Roi) -> Result<f64> {
+        match (&self.intensity, &self.counts) {
+            (Some(i), _) => Ok(roi.mean(name, i.view())?),
+            (None, Some(c)) => {
+                roi.check(name, c.dim())?;
+                let sub = c.slice(s![roi.y..roi.y + roi.h, roi.x..roi.x + roi.w]);
+                let sub = sub.mapv(|v| if v == 0 { f64::NAN } else { f64::from(v) });
+                Ok(Roi::new(0, 0, roi.w, roi.h).mean(name, sub.view())?)
+            }
+            (None, None) => unreachable!("a corrected frame holds counts or an intensity"),
+        }
+    }
+
+    /// Column `x`, rows `y0..y1`, as intensities (the line scan).
+    fn column(&self, x: usize, y0: usize, y1: usize) -> Array2<f64> {
+        match (&self.intensity, &self.counts) {
+            (Some(i), _) => i.slice(s![y0..y1, x..x + 1]).to_owned(),
+            (None, Some(c)) => c
+                .slice(s![y0..y1, x..x + 1])
+                .mapv(|v| if v == 0 { f64::NAN } else { f64::from(v) }),
+            (None, None) => unreachable!("a corrected frame holds counts or an intensity"),
+        }
+    }
+}
+
+/// The frames of the input files in order, one page at a time (a stack's pages one by one).
+struct FrameSource {
+    files: std::vec::IntoIter<PathBuf>,
+    pages: Option<tio::Pages<std::io::BufReader<std::fs::File>>>,
+}
+
+impl FrameSource {
+    fn new(files: Vec<PathBuf>) -> Self {
+        Self {
+            files: files.into_iter(),
+            pages: None,
+        }
+    }
+}
+
+impl Iterator for FrameSource {
+    type Item = Result<tio::Page>;
+    fn next(&mut self) -> Option<Result<tio::Page>> {
+        loop {
+            if let Some(page) = self.pages.as_mut().and_then(Iterator::next) {
+                return Some(page);
+            }
+            let file = self.files.next()?;
+            match tio::pages(&file) {
+                Ok(p) => self.pages = Some(p),
+                Err(e) => return Some(Err(e)),
+            }
+        }
+    }
+}
+
+/// Correct one frame (gamma spots, dark and flat fields, dose, positivity), as its own job:
+/// `counts` keeps 16-bit frames as they are.
+fn correct_frame(
+    p: &Params,
+    page: tio::Page,
+    dark: Option<&Array2<f64>>,
+    flat: Option<&Array2<f64>>,
+    counts: bool,
+) -> Result<Corrected> {
+    let label = page.label;
+    if counts && let tio::Pixels::U16(c) = page.pixels {
+        let zeros = c.par_iter().filter(|&&v| v == 0).count();
+        if zeros > 0 && !p.mask_nonpositive {
+            // The same refusal as a corrected frame's, naming the first such pixel.
+            let mut i = c.mapv(f64::from);
+            correct::check_positive(&mut i, &format!("frame {label}"), false)?;
+        }
+        return Ok(Corrected {
+            label,
+            counts: Some(c),
+            intensity: None,
+            gamma_replaced: 0,
+            dose: 1.0,
+            masked: zeros,
+        });
+    }
+    let mut raw = page.pixels.into_f64();
+    let mut n_g = 0;
+    if let Some(g) = &p.gamma_spots {
+        (raw, n_g) = correct::remove_gamma_spots(raw.view(), g.size, g.threshold)?;
+    }
+    // Without dark and flat fields the frame is its own corrected intensity: no copy.
+    let mut i = if dark.is_none() && flat.is_none() {
+        raw
+    } else {
+        correct::flat_dark(raw.view(), dark.map(|d| d.view()), flat.map(|d| d.view()))
+    };
+    let dose = match p.open_roi {
+        Some(r) => correct::dose_normalise(&mut i, r).with_context(|| format!("frame {label}"))?,
+        None => 1.0,
+    };
+    let masked = correct::check_positive(&mut i, &format!("frame {label}"), p.mask_nonpositive)?;
+    Ok(Corrected {
+        label,
+        counts: None,
+        intensity: Some(i),
+        gamma_replaced: n_g,
+        dose,
+        masked,
+    })
+}
+
+/// `L_alloy^n` of a later frame by the chosen method, and its Eq. (4) map.
+fn thickness_and_map(
+    p: &Params,
+    i_l0: f64,
+    troi0: f64,
+    n: usize,
+    f: &Corrected,
+) -> Result<(f64, FractionMap)> {
+    let l = match (p.thickness, p.thickness_roi) {
+        (Thickness::None, _) | (_, None) => p.l_alloy0,
+        (Thickness::Eq2, Some(r)) => {
+            let m = f.roi_mean("thickness_roi", r)?;
+            bl::thickness_eq2(p.l_alloy0, p.mu_s, p.mu_l, troi0, m, 0.0, 0.0)
+        }
+        (Thickness::Eq3, Some(r)) => {
+            let m = f.roi_mean("thickness_roi", r)?;
+            bl::thickness_eq3(p.l_alloy0, p.mu_s, troi0, m)
+        }
+    };
+    if !(l > 0.0 && l.is_finite()) {
+        bail!(
+            "frame {}: thickness L_alloy^{n} = {l} m from {:?} over thickness_roi is not positive; \
+             check thickness_roi (fully liquid for eq2, fully solid for eq3) and mu_s/mu_l",
+            f.label,
+            p.thickness
+        );
+    }
+    let map = FractionMap::eq4(i_l0, p.mu_s, p.mu_l, p.l_alloy0, l)
+        .map_err(|e| anyhow::anyhow!("frame {}: {e}", f.label))?;
+    Ok((l, map))
 }
 
 fn positive(name: &str, v: f64) -> Result<()> {
@@ -259,9 +436,6 @@ fn one_of(name: &str, value: Option<f64>, roi: Option<Roi>) -> Result<()> {
         ),
     }
 }
-
-/// One corrected frame: label, intensity, gamma spots replaced, dose divisor, masked pixels.
-type Corrected = (String, Array2<f64>, usize, f64, usize);
 
 /// Read, validate and correct every input; no file is written here.
 pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
@@ -309,31 +483,30 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
     }
 
     let paths: Vec<PathBuf> = p.frames.iter().map(|f| ctx.resolve(f)).collect();
-    // Files decoded in parallel (decoding one file is serial: it was a fifth of the stage's
-    // time on 2048² frames, issue 18 item 5); frames keep the files' order, and the error
-    // reported is the first file's in that order.
+    // Every page's header first: the number of frames and their sizes and sample types are
+    // checked before a pixel is decoded; the pixels are read one frame at a time later.
     let files = tio::expand_paths(&paths)?;
-    let pages: Vec<Result<Vec<tio::Frame>>> = files.par_iter().map(|f| tio::read_pages(f)).collect();
-    let mut frames = Vec::new();
-    for f in pages {
-        frames.extend(f?);
+    let heads: Vec<Result<Vec<tio::PageInfo>>> = files.par_iter().map(|f| tio::probe_pages(f)).collect();
+    let mut infos = Vec::new();
+    for h in heads {
+        infos.extend(h?);
     }
-    // 16-bit counts that no correction changes go through a lookup table (one load per pixel
-    // instead of a logarithm) in `write_outputs`.
-    let counts = frames.iter().all(|f| f.bits == 16)
+    // 16-bit counts that no correction changes stay 16-bit and go through a lookup table (one
+    // load per pixel instead of a logarithm) in `write_outputs`.
+    let counts = infos.iter().all(|f| f.bits == 16)
         && p.dark.is_none()
         && p.flat.is_none()
         && p.gamma_spots.is_none()
         && p.open_roi.is_none();
-    let shape = frames[0].data.dim();
-    for f in &frames[1..] {
-        if f.data.dim() != shape {
+    let shape = (infos[0].rows, infos[0].cols);
+    for f in &infos[1..] {
+        if (f.rows, f.cols) != shape {
             bail!(
                 "frame {} is {}x{} (rows x cols) but the first frame {} is {}x{}; all frames must have one size",
                 f.label,
-                f.data.nrows(),
-                f.data.ncols(),
-                frames[0].label,
+                f.rows,
+                f.cols,
+                infos[0].label,
                 shape.0,
                 shape.1
             );
@@ -402,65 +575,26 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
     }
 
     // Corrections.
-    let mut gamma_replaced = Vec::new();
     if let Some(g) = &p.gamma_spots {
         for f in [&mut dark, &mut flat].into_iter().flatten() {
             *f = correct::remove_gamma_spots(f.view(), g.size, g.threshold)?.0;
         }
     }
-    let mut labels = Vec::new();
-    let mut intensity = Vec::new();
-    let (mut dose, mut masked) = (Vec::new(), Vec::new());
-    // Frames corrected in parallel (each correction is per frame); the first error in frame
-    // order is the one reported.
-    let corrected: Vec<Result<Corrected>> = frames
-        .into_par_iter()
-        .map(|f| {
-            let mut raw = f.data;
-            let mut n_g = 0;
-            if let Some(g) = &p.gamma_spots {
-                (raw, n_g) = correct::remove_gamma_spots(raw.view(), g.size, g.threshold)?;
-            }
-            // Without dark and flat fields the frame is its own corrected intensity: no copy.
-            let mut i = if dark.is_none() && flat.is_none() {
-                raw
-            } else {
-                correct::flat_dark(
-                    raw.view(),
-                    dark.as_ref().map(|d| d.view()),
-                    flat.as_ref().map(|d| d.view()),
-                )
-            };
-            let d = match p.open_roi {
-                Some(r) => {
-                    correct::dose_normalise(&mut i, r).with_context(|| format!("frame {}", f.label))?
-                }
-                None => 1.0,
-            };
-            let n_masked =
-                correct::check_positive(&mut i, &format!("frame {}", f.label), p.mask_nonpositive)?;
-            Ok((f.label, i, n_g, d, n_masked))
-        })
-        .collect();
-    for c in corrected {
-        let (label, i, n_g, d, n_masked) = c?;
-        gamma_replaced.push(n_g);
-        dose.push(d);
-        masked.push(n_masked);
-        labels.push(label);
-        intensity.push(i);
-    }
+    let mut source = FrameSource::new(files);
+    let page0 = source
+        .next()
+        .context("no frame to read: the frame files hold no pages")??;
+    let first = correct_frame(p, page0, dark.as_ref(), flat.as_ref(), counts)?;
 
     // Reference intensities and Eq. (1a).
-    let i0 = &intensity[0];
     let i_l0 = match (p.i_l0, p.i_l0_roi) {
         (Some(v), _) => v,
-        (_, Some(r)) => r.mean("i_l0_roi", i0.view())?,
+        (_, Some(r)) => first.roi_mean("i_l0_roi", r)?,
         _ => unreachable!("checked by one_of"),
     };
     let i_s0 = match (p.i_s0, p.i_s0_roi) {
         (Some(v), _) => v,
-        (_, Some(r)) => r.mean("i_s0_roi", i0.view())?,
+        (_, Some(r)) => first.roi_mean("i_s0_roi", r)?,
         _ => unreachable!("checked by one_of"),
     };
     let map0 = FractionMap::eq1(i_l0, i_s0).map_err(|e| anyhow::anyhow!("parameters 'i_l0'/'i_s0': {e}"))?;
@@ -474,54 +608,25 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
              eps_vol is biased; check mu_s, mu_l, l_alloy0 and the reference ROIs"
         ));
     }
-
-    // Thickness of every frame and its Eq. (4) map.
-    let mut thickness = vec![p.l_alloy0];
-    let mut maps = vec![map0];
     let troi0 = match (p.thickness, p.thickness_roi) {
         (Thickness::None, _) | (_, None) => f64::NAN,
-        (_, Some(r)) => r.mean("thickness_roi", i0.view())?,
+        (_, Some(r)) => first.roi_mean("thickness_roi", r)?,
     };
-    for (n, i) in intensity.iter().enumerate().skip(1) {
-        let l = match (p.thickness, p.thickness_roi) {
-            (Thickness::None, _) | (_, None) => p.l_alloy0,
-            (Thickness::Eq2, Some(r)) => {
-                let m = r.mean("thickness_roi", i.view())?;
-                bl::thickness_eq2(p.l_alloy0, p.mu_s, p.mu_l, troi0, m, 0.0, 0.0)
-            }
-            (Thickness::Eq3, Some(r)) => {
-                let m = r.mean("thickness_roi", i.view())?;
-                bl::thickness_eq3(p.l_alloy0, p.mu_s, troi0, m)
-            }
-        };
-        if !(l > 0.0 && l.is_finite()) {
-            bail!(
-                "frame {}: thickness L_alloy^{n} = {l} m from {:?} over thickness_roi is not positive; \
-                 check thickness_roi (fully liquid for eq2, fully solid for eq3) and mu_s/mu_l",
-                labels[n],
-                p.thickness
-            );
-        }
-        thickness.push(l);
-        maps.push(
-            FractionMap::eq4(i_l0, p.mu_s, p.mu_l, p.l_alloy0, l)
-                .map_err(|e| anyhow::anyhow!("frame {}: {e}", labels[n]))?,
-        );
-    }
     Ok(Prepared {
-        labels,
-        intensity,
+        labels: infos.into_iter().map(|i| i.label).collect(),
+        shape,
         rev_side,
         i_l0,
         i_s0,
-        thickness,
-        maps,
-        gamma_replaced,
-        dose,
-        masked,
+        troi0,
+        map0,
         warnings,
         bulk,
         counts,
+        first,
+        source,
+        dark,
+        flat,
     })
 }
 
@@ -695,17 +800,56 @@ impl Drop for MapWriter {
     }
 }
 
-fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageOutput> {
+fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOutput> {
     let out = &ctx.out_dir;
     let mut files: Vec<PathBuf> = Vec::new();
     let mut figures = Vec::new();
     let mut tables = Vec::new();
-    let nf = pr.intensity.len();
-    let shape = pr.intensity[0].dim();
+    let nf = pr.labels.len();
+    let shape = pr.shape;
     let area = p.global_area.unwrap_or(Roi::new(0, 0, shape.1, shape.0));
     let png_frame = |n: usize| p.plots && (nf <= 8 || n == 0 || n + 1 == nf);
     let mm = |px: f64| px * p.pixel_size * 1e3;
 
+    // The later frames are read and corrected on their own thread, one ahead of the frame being
+    // processed. If this loop stops on an error the channel closes and the reader stops too; it
+    // only reads, so nothing is left in the stage's directory.
+    let mut frames = {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Corrected>>(1);
+        let (params, source, counts) = (p.clone(), pr.source, pr.counts);
+        let (dark, flat) = (pr.dark, pr.flat);
+        std::thread::spawn(move || {
+            for page in source {
+                let c = page.and_then(|pg| {
+                    if pg.pixels.dim() != shape {
+                        let (r, c) = pg.pixels.dim();
+                        bail!(
+                            "frame {} is {r}x{c} (rows x cols) but its header and the first frame say {}x{}",
+                            pg.label,
+                            shape.0,
+                            shape.1
+                        );
+                    }
+                    correct_frame(&params, pg, dark.as_ref(), flat.as_ref(), counts)
+                });
+                let failed = c.is_err();
+                if tx.send(c).is_err() || failed {
+                    break;
+                }
+            }
+        });
+        let mut first = Some(pr.first);
+        move |n: usize| -> Result<Corrected> {
+            match first.take() {
+                Some(f) if n == 0 => Ok(f),
+                _ => rx.recv().map_err(|_| {
+                    anyhow::anyhow!(
+                        "frame {n}: the thread reading the frames stopped before it (the files changed?)"
+                    )
+                })?,
+            }
+        }
+    };
     let pb = ctx.progress_bar(nf as u64, "radiograph");
     let mut sat = Sat::new();
     let mut g0_rev = Array2::zeros(shape);
@@ -715,23 +859,31 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
     let mut maps = MapWriter::new();
     let mut flagger = pr.bulk.map(|b| edge::Flagger::new(b, pr.rev_side)).transpose()?;
     let mut eps_buf = Array2::zeros(shape);
-    let mut counts = Array2::<u16>::zeros(if pr.counts { shape } else { (0, 0) });
+    let mut lines = Vec::new();
     for n in 0..nf {
-        if pr.counts && !p.write_pixel_maps {
+        let fr = frames(n)?;
+        let (thickness, map) = if n == 0 {
+            (p.l_alloy0, pr.map0)
+        } else {
+            thickness_and_map(p, pr.i_l0, pr.troi0, n, &fr)?
+        };
+        if let Some(ls) = &p.line_scan {
+            lines.push(fr.column(ls.x, ls.y0, ls.y1));
+        }
+        match (&fr.counts, p.write_pixel_maps) {
             // The pixel fraction of every count from a table, straight into the summed-area
             // table: no logarithm per pixel and no pixel-fraction field (issue 18 item 5).
-            Zip::from(&mut counts)
-                .and(&pr.intensity[n])
-                .par_for_each(|c, &v| *c = v as u16);
-            sat.build_u16(counts.view(), &pr.maps[n].lut_u16());
-        } else {
-            let gpix = pr.maps[n].field(pr.intensity[n].view());
-            sat.build(gpix.view());
-            if p.write_pixel_maps {
-                for (name, f) in [("intensity", pr.intensity[n].clone()), ("gs_pixel", gpix)] {
-                    let fname = format!("{name}_{n:03}.tif");
-                    maps.write(out.join(&fname), f)?;
-                    files.push(fname.into());
+            (Some(c), false) => sat.build_u16(c.view(), &map.lut_u16()),
+            _ => {
+                let intensity = fr.intensity();
+                let gpix = map.field(intensity.view());
+                sat.build(gpix.view());
+                if p.write_pixel_maps {
+                    for (name, f) in [("intensity", intensity.into_owned()), ("gs_pixel", gpix)] {
+                        let fname = format!("{name}_{n:03}.tif");
+                        maps.write(out.join(&fname), f)?;
+                        files.push(fname.into());
+                    }
                 }
             }
         }
@@ -855,16 +1007,16 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
         frames_json.push(json!({
             "frame": n,
             "label": pr.labels[n],
-            "thickness_m": pr.thickness[n],
-            "i_l_n": pr.i_l0 * (-p.mu_l * (pr.thickness[n] - p.l_alloy0)).exp(),
+            "thickness_m": thickness,
+            "i_l_n": pr.i_l0 * (-p.mu_l * (thickness - p.l_alloy0)).exp(),
             "g_s_global": global,
             "g_s_rev_mean": stats.g_mean(),
             "eps_vol_mean": eps_json,
             "near_edge_fraction": near_json,
             "eps_vol_mean_away_from_edges": eps_away_json,
-            "dose_divisor": pr.dose[n],
-            "gamma_spots_replaced": pr.gamma_replaced[n],
-            "masked_pixels": pr.masked[n],
+            "dose_divisor": fr.dose,
+            "gamma_spots_replaced": fr.gamma_replaced,
+            "masked_pixels": fr.masked,
         }));
         outs.push(FrameOut {
             gs_tiles,
@@ -1000,11 +1152,9 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: &Prepared) -> Result<StageO
     if let Some(ls) = &p.line_scan {
         let y: Vec<f64> = (ls.y0..ls.y1).map(|r| (r as f64 + 0.5) * p.pixel_size).collect();
         let mut cols: Vec<(String, Vec<f64>)> = vec![("y_mm".into(), y.iter().map(|v| v * 1e3).collect())];
-        let line0 = pr.intensity[0].slice(s![ls.y0..ls.y1, ls.x..ls.x + 1]).to_owned();
         let mut series = Vec::new();
-        for n in 0..nf {
-            let line = pr.intensity[n].slice(s![ls.y0..ls.y1, ls.x..ls.x + 1]).to_owned();
-            let l = bl::thickness_field_eq2(p.l_alloy0, p.mu_l, line0.view(), line.view());
+        for (n, line) in lines.iter().enumerate() {
+            let l = bl::thickness_field_eq2(p.l_alloy0, p.mu_l, lines[0].view(), line.view());
             let l: Vec<f64> = l.iter().copied().collect();
             if n > 0 && ls.fit_half_width > 0.0 {
                 match profile::meniscus_fit(&y, &l, ls.fit_half_width, ls.gamma) {
