@@ -113,6 +113,23 @@ fn su2020_ci_pipeline_analyses_compares_maps_and_reports() {
     assert!(last > 0.70 && last < 0.85, "{frac:?}");
     let float = json(&out.join("analyse-float/analysis.json"));
     assert_eq!(float["packed_zone"]["pairs"].as_u64(), Some(frac.len() as u64));
+    // The bands of the last pair: the zone is the run of still bands from the top, and its
+    // fraction is their mean (bands of one height). One band here, so no interior fraction.
+    let b = out.join("analyse-float/packed_zone_bands.csv");
+    let bdf = lbdem::report::table::read_table(&b).unwrap();
+    let band = lbdem::report::table::f64_column(&bdf, "fraction", &b).unwrap();
+    let still = lbdem::report::table::f64_column(&bdf, "still", &b).unwrap();
+    let zone: Vec<f64> = band
+        .iter()
+        .zip(&still)
+        .take_while(|(_, s)| **s == 1.0)
+        .map(|(f, _)| *f)
+        .collect();
+    assert!(!zone.is_empty(), "{still:?}");
+    let mean = zone.iter().sum::<f64>() / zone.len() as f64;
+    assert!((mean - last).abs() < 1e-12, "bands {zone:?}, zone {last}");
+    let inner = lbdem::report::table::f64_column(&df, "packed_zone_interior_fraction", &p).unwrap();
+    assert_eq!(zone.len() < 3, inner[inner.len() - 1].is_nan(), "{inner:?}");
 
     // The run rendered as radiographs and put through the radiograph stage: XIP beside TRI on the
     // same snapshots. Measured at u_y = 0.95 d (since the resting solid zone, 2026-11-25): XIP

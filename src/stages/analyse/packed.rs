@@ -9,17 +9,23 @@ use super::Params;
 use crate::contract::{Figure, Table};
 use crate::report::lines::{Line, LinesPlot, Reference, Style, lines_png};
 use crate::report::table::{Col, write_table};
-use crate::scenes::models::packed_zone::PackedZone;
+use crate::scenes::models::packed_zone::{Band, PackedZone, interior_fraction};
 use crate::stages::run_data::Run;
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 
 /// The zone by displacement at every particle snapshot that has one `window` earlier:
-/// (time of the later snapshot, packing fraction, height).
-pub fn by_displacement(run: &Run, zone: &PackedZone, window: f64, moved: f64) -> Result<Vec<[f64; 3]>> {
+/// (time of the later snapshot, packing fraction, height, interior packing fraction
+/// ([`interior_fraction`])), and the bands of the last pair.
+pub fn by_displacement(
+    run: &Run,
+    zone: &PackedZone,
+    window: f64,
+    moved: f64,
+) -> Result<(Vec<[f64; 4]>, Vec<Band>)> {
     let steps = run.particle_steps();
     let times: Vec<f64> = steps.iter().map(|&s| run.time_of(s)).collect();
-    let mut rows = Vec::new();
+    let (mut rows, mut bands) = (Vec::new(), Vec::new());
     for (k1, &t1) in times.iter().enumerate() {
         // The earlier snapshot closest to t1 − window, within 1 % of the window.
         let Some(k0) = (0..k1)
@@ -49,10 +55,12 @@ pub fn by_displacement(run: &Run, zone: &PackedZone, window: f64, moved: f64) ->
             let still = (b[0] - a[0]).hypot(b[1] - a[1]) < moved;
             (g1.area[k], still, g1.circles[k].iter().map(|c| (c[1], c[2])))
         });
-        let [fraction, height, _] = zone.measure(grains);
-        rows.push([t1, fraction, height]);
+        let (b, _) = zone.bands(grains);
+        let [fraction, height] = zone.zone(&b);
+        rows.push([t1, fraction, height, interior_fraction(&b)]);
+        bands = b;
     }
-    Ok(rows)
+    Ok((rows, bands))
 }
 
 /// Fig. 5h: the packed zone's packing fraction over time, by speed (the series) and by
@@ -76,9 +84,9 @@ pub(super) fn analyse(
             p.packed_moved_less_than
         );
     }
-    let rows = by_displacement(run, &zone, p.packed_window, p.packed_moved_less_than)?;
+    let (rows, bands) = by_displacement(run, &zone, p.packed_window, p.packed_moved_less_than)?;
     let col = |i: usize| rows.iter().map(|r| r[i]).collect::<Vec<f64>>();
-    let (t_d, frac_d, height_d) = (col(0), col(1), col(2));
+    let (t_d, frac_d, height_d, inner_d) = (col(0), col(1), col(2), col(3));
     let name = "packed_zone_displacement.csv";
     write_table(
         &out.join(name),
@@ -86,6 +94,7 @@ pub(super) fn analyse(
             ("time", Col::F64(&t_d)),
             ("packed_zone_fraction", Col::F64(&frac_d)),
             ("packed_zone_height", Col::F64(&height_d)),
+            ("packed_zone_interior_fraction", Col::F64(&inner_d)),
         ],
     )?;
     files.push(name.into());
@@ -94,10 +103,38 @@ pub(super) fn analyse(
         caption: format!(
             "The packed zone by Su's criterion (Sect. 3.2): at each particle snapshot with one {} s earlier, \
              the run of bands from the packing side whose grains all moved less than {:e} m since; its \
-             packing fraction (NaN: no band packed) and height (m).",
+             packing fraction (NaN: no band packed) and height (m), and its interior packing fraction \
+             (without the band against the wall and the ragged lowest band; NaN under three bands).",
             p.packed_window, p.packed_moved_less_than
         ),
     });
+    if !bands.is_empty() {
+        let name = "packed_zone_bands.csv";
+        let depth: Vec<f64> = bands.iter().map(|b| b.depth).collect();
+        let fraction: Vec<f64> = bands.iter().map(|b| b.fraction).collect();
+        let still: Vec<f64> = bands.iter().map(|b| f64::from(u8::from(b.still))).collect();
+        write_table(
+            &out.join(name),
+            &[
+                ("depth", Col::F64(&depth)),
+                ("fraction", Col::F64(&fraction)),
+                ("still", Col::F64(&still)),
+            ],
+        )?;
+        files.push(name.into());
+        tables.push(Table {
+            path: name.into(),
+            caption: format!(
+                "The bands of the last snapshot pair (t = {:.4} s) from the packing side: depth of the band's middle \
+                 (m), the grains' area in it over its area, and whether all its grains moved less than {:e} m in \
+                 {} s (1) or not (0). The zone is the run of still bands from the packing side; inside it the \
+                 profile shows the wall layer, the bulk and the ragged lower edge.",
+                rows.last().map_or(f64::NAN, |r| r[0]),
+                p.packed_moved_less_than,
+                p.packed_window
+            ),
+        });
+    }
     let t = run.series("time").unwrap_or_default();
     let pz = run.series("packed_zone_fraction").unwrap_or_default();
     let fov = run.series("packing_box").unwrap_or_default();
@@ -118,6 +155,13 @@ pub(super) fn analyse(
                 y: &frac_d,
                 style: Style::LinePoints,
                 colour: Some((20, 150, 60)),
+            },
+            Line {
+                label: "f_S,pk,PK inside the zone, edge bands left out (snapshots)",
+                x: &t_d,
+                y: &inner_d,
+                style: Style::Points,
+                colour: Some((120, 40, 160)),
             },
             Line {
                 label: "f_S,pk,FOV (box)",
@@ -155,6 +199,7 @@ pub(super) fn analyse(
         "window_s": p.packed_window,
         "moved_less_than_m": p.packed_moved_less_than,
         "pairs": rows.len(),
-        "last_packed": last.map(|r| serde_json::json!({"time_s": r[0], "fraction": r[1], "height_m": r[2]})),
+        "last_packed": last.map(|r| serde_json::json!({"time_s": r[0], "fraction": r[1], "height_m": r[2],
+                                                        "interior_fraction": r[3]})),
     })))
 }
