@@ -17,6 +17,28 @@ pub struct Frame {
     pub area_px: (f64, f64),
 }
 
+impl Frame {
+    /// A chart's frame on ranges `x` and `y` ((lo, hi), `log` per axis) and an 800 × 560 PNG's
+    /// plotting area, with the legend's entries counted from their `labels` (empty ones have none).
+    pub fn new<'a>(
+        x: (f64, f64),
+        y: (f64, f64),
+        log: (bool, bool),
+        labels: impl Iterator<Item = &'a str> + Clone,
+    ) -> Self {
+        let labels = labels.filter(|l| !l.is_empty());
+        Self {
+            x,
+            y,
+            log_x: log.0,
+            log_y: log.1,
+            entries: labels.clone().count(),
+            longest: labels.map(|l| l.chars().count()).max().unwrap_or(0),
+            area_px: (695.0, 460.0),
+        }
+    }
+}
+
 /// Fraction of the axis from its low end, in the axis's scale.
 fn along(v: f64, (lo, hi): (f64, f64), log: bool) -> f64 {
     if log {

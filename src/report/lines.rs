@@ -93,18 +93,9 @@ pub fn lines_png(path: &Path, lines: &[Line], opts: &LinesPlot) -> Result<()> {
     let labels = lines
         .iter()
         .map(|l| l.label)
-        .chain(opts.h_refs.iter().chain(&opts.v_refs).map(|r| r.label))
-        .filter(|l| !l.is_empty());
+        .chain(opts.h_refs.iter().chain(&opts.v_refs).map(|r| r.label));
     let corner = legend::quietest_corner(
-        &legend::Frame {
-            x: (x0, x1),
-            y: (y0, y1),
-            log_x: opts.log_x,
-            log_y: opts.log_y,
-            entries: labels.clone().count(),
-            longest: labels.map(|l| l.chars().count()).max().unwrap_or(0),
-            area_px: (695.0, 460.0),
-        },
+        &legend::Frame::new((x0, x1), (y0, y1), (opts.log_x, opts.log_y), labels),
         lines
             .iter()
             .flat_map(|l| l.x.iter().copied().zip(l.y.iter().copied())),

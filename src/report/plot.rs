@@ -319,17 +319,9 @@ pub fn xy_png(path: &Path, series: &[Series], opts: &XyPlot) -> Result<()> {
     };
     let (x0, x1) = padded(x0, x1, opts.log_x);
     let (y0, y1) = padded(y0, y1, opts.log_y);
-    let labels = series.iter().map(|s| s.label).filter(|l| !l.is_empty());
+    let labels = series.iter().map(|s| s.label);
     let corner = super::legend::quietest_corner(
-        &super::legend::Frame {
-            x: (x0, x1),
-            y: (y0, y1),
-            log_x: opts.log_x,
-            log_y: opts.log_y,
-            entries: labels.clone().count(),
-            longest: labels.map(|l| l.chars().count()).max().unwrap_or(0),
-            area_px: (700.0, 460.0),
-        },
+        &super::legend::Frame::new((x0, x1), (y0, y1), (opts.log_x, opts.log_y), labels),
         series
             .iter()
             .flat_map(|s| s.x.iter().copied().zip(s.y.iter().copied())),
