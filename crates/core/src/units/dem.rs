@@ -32,6 +32,17 @@ pub fn largest_accepted_step(m_min: f64, k_grain: f64, k_wall: f64, walls: bool)
     2.0 * (m_min / k).sqrt()
 }
 
+/// The largest step (s) at which the kick-drift-kick leapfrog keeps a spring `k` (N/m) and a
+/// dashpot `c` (N s/m) on a mass `m` (kg) stable, the dashpot reading the half-step velocity as
+/// the stepper's force pass does. With u = h v the step maps (x, u) by [[1 − a², 1 − b],
+/// [−a², 1 − b]], a = h √(k/m), b = h c/m: trace 2 − a² − b, determinant 1 − b, and the Jury
+/// conditions reduce to a² + 2b < 4, i.e. k h² + 2 c h < 4 m. Without the dashpot it is Verlet's
+/// 2 √(m/k); with damping ratio ζ = c/(2√(km)) it is 2(√(1+ζ²) − ζ)/ω. Written as
+/// 4m/(c + √(c² + 4km)) so that it stays exact for c ≫ √(km).
+pub fn damped_step_limit(k: f64, c: f64, m: f64) -> f64 {
+    4.0 * m / (c + (c * c + 4.0 * k * m).sqrt())
+}
+
 /// Damping ratio ζ of a linear spring-dashpot that gives the restitution coefficient `e`:
 /// e = exp(−πζ/√(1−ζ²))  ⇔  ζ = −ln e / √(π² + ln² e).
 pub fn damping_ratio_from_restitution(e: f64) -> f64 {
@@ -57,6 +68,37 @@ mod tests {
         assert!((largest_accepted_step(8.0, 1.0, 1.0, true) - 2.0).abs() < 1e-14);
         let s = largest_accepted_step(1.0, 1e-4, 1.0, true);
         assert!(s > 1.0 && s < 2f64.sqrt(), "{s}");
+    }
+
+    /// The scalar recurrence itself, run just inside and just outside the closed form: a
+    /// displaced mass decays inside and grows outside, at ζ = 0, 0.5 and 2 (where the dashpot
+    /// alone, not the spring, sets the limit).
+    #[test]
+    fn the_damped_limit_separates_decaying_from_growing_runs() {
+        let (k, m) = (31.1_f64, 2.9e-9_f64);
+        for zeta in [0.0, 0.5, 2.0] {
+            let c = 2.0 * zeta * (k * m).sqrt();
+            let h_max = damped_step_limit(k, c, m);
+            let amplitude = |h: f64| {
+                let (mut x, mut v, mut f) = (1e-9, 0.0, -k * 1e-9);
+                for _ in 0..2_000 {
+                    v += 0.5 * h * f / m;
+                    x += h * v;
+                    f = -k * x - c * v;
+                    v += 0.5 * h * f / m;
+                }
+                x.abs().max((v * h).abs())
+            };
+            // Inside: bounded by a few times the 1 nm start (undamped) or decayed; outside: a
+            // thousandfold growth or an overflow within 2000 steps.
+            let inside = amplitude(0.99 * h_max);
+            let outside = amplitude(1.01 * h_max);
+            assert!(inside < 1e-8, "zeta {zeta}: {inside}");
+            assert!(outside.is_nan() || outside >= 1e-6, "zeta {zeta}: {outside}");
+        }
+        // The undamped limit is Verlet's 2 sqrt(m/k), and a dashpot only lowers it.
+        assert!((damped_step_limit(4.0, 0.0, 1.0) - 1.0).abs() < 1e-15);
+        assert!(damped_step_limit(4.0, 0.1, 1.0) < 1.0);
     }
 
     #[test]
