@@ -21,6 +21,21 @@ pub enum DemError {
         m_min: f64,
         k_max: f64,
     },
+    #[error(
+        "time step dt = {dt:e} s is above {limit:e} s, the largest step at which body {body} resting \
+         on a wall stays still: the contact's spring ({k_wall:e} N/m) and dashpot ({c_wall:e} N s/m) \
+         act off the centroid, where the grain moves like a lighter mass than the dashpot was set \
+         for, and past this step the explicit dashpot overshoots every step, so grains rattle \
+         against the walls or creep along them without end (docs/stability.md, \"Wall contacts of \
+         clumps\"); lower dt below {limit:e} s, or lower the wall law's damping ratio"
+    )]
+    WallContactStepTooLarge {
+        dt: f64,
+        limit: f64,
+        body: usize,
+        k_wall: f64,
+        c_wall: f64,
+    },
     #[error("body {body}: non-finite state at step {step} (position or velocity is NaN/inf); {}", blame(*step))]
     NonFinite { body: usize, step: u64 },
     #[error(

@@ -31,13 +31,13 @@ pub mod vector;
 pub mod wall;
 
 pub use body::Bodies;
-pub use contact::{ContactLaw, Damping, History, Law, LawVisitor};
+pub use contact::{ContactLaw, Damping, History, Law, LawVisitor, SpringDashpots};
 pub use domain::Domain;
 pub use error::DemError;
 pub use history::{Histories, HistoryData};
 pub use neighbor::Contacts;
 pub use shape::{Ball, ClumpShape, MassProps2};
-pub use stepper::{ForceHook, StepParams, Stepper};
+pub use stepper::{ForceHook, StepParams, Stepper, WallContactStep};
 pub use system::{Membrane, System};
 pub use vector::{Vec2, Vec3, Vector};
 pub use wall::{ServoLength, Wall, WallMotion, WallShape};

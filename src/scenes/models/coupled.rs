@@ -150,18 +150,9 @@ impl<T: Real> CoupledModel<T> {
         };
         let law = s.contact.clone().context("[contact] is required")?;
         let wall_law = s.wall_contact.clone().unwrap_or_else(|| law.clone());
-        let (crit, m_min, k_max) = lbdem_dem::Stepper::critical_time_step(&sys, &law, &wall_law);
-        let limit = lbdem_dem::Stepper::largest_accepted_step(&sys, &law, &wall_law);
-        if !(dem.dt > 0.0 && dem.dt <= limit) {
-            bail!(
-                "[dem] dt = {:e} s is above the largest accepted step {limit:e} s: the lightest grain \
-                 ({m_min:e} kg) held by six grain springs and pressed by two walls (critical step \
-                 sqrt(m_min/k_max) = {crit:e} s, stiffest contact {k_max:e} N/m); a dense packing \
-                 blows up beyond it (docs/stability.md); lower [dem] dt (and [lattice] dt with it, \
-                 keeping a whole ratio)",
-                dem.dt
-            );
-        }
+        lbdem_dem::Stepper::check_step(&sys, &law, &wall_law, dem.dt).map_err(|e| {
+            anyhow::anyhow!("[dem] dt: {e} (lower [lattice] dt with it, keeping a whole ratio)")
+        })?;
         hydro
             .set_remap_tolerance(cs.remap_tolerance)
             .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;

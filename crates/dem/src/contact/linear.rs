@@ -3,7 +3,7 @@
 //! rolling resistance parts" of Su et al. 2020 Sect. 2.3; Ness et al. 2017 Eq. 6 frictional
 //! contacts: F_n = k_n δ n, |F_t| ≤ μ |F_n|).
 
-use super::{ContactInput, ContactLaw, ContactOutput, Damping, History, Rolling, tangential};
+use super::{ContactInput, ContactLaw, ContactOutput, Damping, History, Rolling, SpringDashpots, tangential};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,6 +77,17 @@ impl ContactLaw for LinearSpringDashpot {
     }
     fn friction(&self) -> f64 {
         self.mu
+    }
+    fn spring_dashpots(&self, _r_eff: f64, m_eff: f64) -> SpringDashpots {
+        let cn = self.damping.coefficient(self.k_n, m_eff);
+        SpringDashpots {
+            normal: (self.k_n, cn),
+            tangential: if self.mu > 0.0 {
+                (self.k_t, cn * self.tangential_damping)
+            } else {
+                (0.0, 0.0)
+            },
+        }
     }
     fn linear(&self) -> Option<&LinearSpringDashpot> {
         Some(self)

@@ -75,6 +75,17 @@ pub trait ContactLaw: Sync + Send {
     fn max_stiffness(&self, r_eff: f64) -> f64;
     /// Friction coefficient (for diagnostics and generation protocols).
     fn friction(&self) -> f64;
+    /// The (stiffness N/m, dashpot N s/m) pairs the law puts along the normal and along the
+    /// tangent of a contact between a circle of radius `r_eff` and a body of mass `m_eff`, for
+    /// the damped step limit of a wall contact ([`crate::Stepper::wall_contact_step`]). The
+    /// default is the largest stiffness along the normal and no dashpot (laws whose dashpot the
+    /// check does not model).
+    fn spring_dashpots(&self, r_eff: f64, _m_eff: f64) -> SpringDashpots {
+        SpringDashpots {
+            normal: (self.max_stiffness(r_eff), 0.0),
+            tangential: (0.0, 0.0),
+        }
+    }
     /// Gap (m) beyond touching within which the law acts between circles of radii `r_i`, `r_j`
     /// (0: contact only). Pairs with a gap below it are evaluated with `delta < 0`; the Verlet
     /// list reaches r_i + r_j + range + skin. Must not decrease with the radii (the cell size
@@ -95,6 +106,13 @@ pub trait ContactLaw: Sync + Send {
     fn linear(&self) -> Option<&LinearSpringDashpot> {
         None
     }
+}
+
+/// A contact's springs and dashpots, as (k N/m, c N s/m), along the normal and the tangent.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpringDashpots {
+    pub normal: (f64, f64),
+    pub tangential: (f64, f64),
 }
 
 /// Calls `visit` with the concrete law inside a [`Law`] (static dispatch: the callee is
@@ -225,6 +243,11 @@ macro_rules! register_laws {
             fn friction(&self) -> f64 {
                 match self {
                     $(Law::$variant(l) => l.friction(),)+
+                }
+            }
+            fn spring_dashpots(&self, r_eff: f64, m_eff: f64) -> SpringDashpots {
+                match self {
+                    $(Law::$variant(l) => l.spring_dashpots(r_eff, m_eff),)+
                 }
             }
             #[inline]

@@ -107,6 +107,17 @@ impl ContactLaw for ElasticPlastic {
     fn max_stiffness(&self, _r_eff: f64) -> f64 {
         self.k_e.max(self.k_t)
     }
+    fn spring_dashpots(&self, _r_eff: f64, m_eff: f64) -> super::SpringDashpots {
+        let cn = self.damping.coefficient(self.k_e, m_eff);
+        super::SpringDashpots {
+            normal: (self.k_e, cn),
+            tangential: if self.mu > 0.0 {
+                (self.k_t, 0.5 * cn)
+            } else {
+                (0.0, 0.0)
+            },
+        }
+    }
     fn friction(&self) -> f64 {
         self.mu
     }

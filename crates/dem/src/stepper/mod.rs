@@ -28,6 +28,7 @@ mod kick;
 mod membrane;
 mod pairs;
 mod rebuild;
+mod wall_modes;
 mod walls;
 
 pub use hooks::ForceHook;
@@ -40,6 +41,7 @@ use crate::system::System;
 use crate::vector::{Vec2, Vector};
 use crate::wall::update_wall_velocities;
 use finish::Finish;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -87,6 +89,17 @@ const CIRCLE_CHUNK: usize = 1024;
 
 /// Pairs per parallel task of the pair pass (any value gives the same bits).
 const PAIR_CHUNK: usize = 1024;
+
+/// A body whose wall contact is unstable at the step asked ([`Stepper::unstable_wall_contact`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallContactStep {
+    /// The largest step (s) at which it is stable.
+    pub limit: f64,
+    pub body: usize,
+    /// The wall law's normal stiffness (N/m) and dashpot (N s/m) on that body.
+    pub k: f64,
+    pub c: f64,
+}
 
 /// Scratch for stepping a [`System`].
 #[derive(Default)]
@@ -151,9 +164,10 @@ impl Stepper {
         (lbdem_core::units::dem::critical_time_step(m_min, k), m_min, k)
     }
 
-    /// The largest step the stepper accepts (s), [`lbdem_core::units::dem::largest_accepted_step`]:
-    /// the lightest body held by six grain springs (contacts or membrane bonds) and, if the system
-    /// has walls, pressed by two walls.
+    /// The largest step the stepper accepts (s) for the grains' springs,
+    /// [`lbdem_core::units::dem::largest_accepted_step`]: the lightest body held by six grain
+    /// springs and, if the system has walls, pressed by two walls. [`Stepper::check_step`] also
+    /// refuses a step at which a clump's wall contact is unstable ([`Stepper::unstable_wall_contact`]).
     pub fn largest_accepted_step<L: ContactLaw, W: ContactLaw>(sys: &System, law: &L, wall_law: &W) -> f64 {
         let b = &sys.bodies;
         let m_min = b.mass.iter().copied().fold(f64::INFINITY, f64::min);
@@ -168,6 +182,79 @@ impl Stepper {
             wall_law.max_stiffness(r_max),
             !sys.walls.is_empty(),
         )
+    }
+
+    /// The body whose wall contact is unstable at step `dt` with the lowest stable step, if any
+    /// is ([`wall_modes`]: each body resting on a wall by two circles or by one, its contacts
+    /// linearised, the step's spectral radius). `None` without walls or when every body is
+    /// stable. Unstable bodies are searched for their largest stable step, so the answer names
+    /// the step that holds them all.
+    pub fn unstable_wall_contact<W: ContactLaw>(
+        sys: &System,
+        wall_law: &W,
+        dt: f64,
+    ) -> Option<WallContactStep> {
+        if sys.walls.is_empty() {
+            return None;
+        }
+        let b = &sys.bodies;
+        (0..b.len())
+            .into_par_iter()
+            .filter_map(|k| {
+                let (m, i) = (b.mass[k], b.inertia[k]);
+                if !(m.is_finite() && m > 0.0 && i.is_finite() && i > 0.0) {
+                    return None;
+                }
+                let circles = b.circle_start[k]..b.circle_start[k + 1];
+                let r_max = b.circle_r[circles.clone()].iter().copied().fold(0.0, f64::max);
+                let sd = wall_law.spring_dashpots(r_max, m);
+                let ways = wall_modes::resting_ways(&b.circle_offset[circles.clone()], &b.circle_r[circles]);
+                if wall_modes::stable(&ways, m, i, &sd, dt) {
+                    return None;
+                }
+                Some(WallContactStep {
+                    limit: wall_modes::largest_stable_step(&ways, m, i, &sd),
+                    body: k,
+                    k: sd.normal.0,
+                    c: sd.normal.1,
+                })
+            })
+            .min_by(|x, y| x.limit.total_cmp(&y.limit).then(x.body.cmp(&y.body)))
+    }
+
+    /// Refuses `dt` if it is not a positive finite step, if a body resting on a wall is unstable
+    /// at it ([`Stepper::unstable_wall_contact`]) or if it is above
+    /// [`Stepper::largest_accepted_step`], naming the bound that refused it.
+    pub fn check_step<L: ContactLaw, W: ContactLaw>(
+        sys: &System,
+        law: &L,
+        wall_law: &W,
+        dt: f64,
+    ) -> Result<(), DemError> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(DemError::BadTimeStep { dt });
+        }
+        if let Some(wall) = Self::unstable_wall_contact(sys, wall_law, dt) {
+            return Err(DemError::WallContactStepTooLarge {
+                dt,
+                limit: wall.limit,
+                body: wall.body,
+                k_wall: wall.k,
+                c_wall: wall.c,
+            });
+        }
+        let limit = Self::largest_accepted_step(sys, law, wall_law);
+        if dt > limit {
+            let (critical, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
+            return Err(DemError::TimeStepTooLarge {
+                dt,
+                limit,
+                critical,
+                m_min,
+                k_max,
+            });
+        }
+        Ok(())
     }
 
     /// [`Stepper::step`] compiled in this crate for the scene-selectable [`Law`]: the pair law
@@ -277,19 +364,10 @@ impl Stepper {
         let shape = (sys.bodies.n_circles(), sys.bodies.len());
         self.kick.resize(sys.bodies.len(), Kick::default());
         if self.checked_dt != dt || (self.n_circles, self.n_bodies) != shape {
-            let (crit, m_min, k_max) = Self::critical_time_step(sys, law, wall_law);
-            if !(dt > 0.0 && dt.is_finite()) {
-                return Err(DemError::BadTimeStep { dt });
-            }
-            let limit = Self::largest_accepted_step(sys, law, wall_law);
-            if dt > limit && !self.past_critical {
-                return Err(DemError::TimeStepTooLarge {
-                    dt,
-                    limit,
-                    critical: crit,
-                    m_min,
-                    k_max,
-                });
+            match Self::check_step(sys, law, wall_law, dt) {
+                Err(DemError::BadTimeStep { dt }) => return Err(DemError::BadTimeStep { dt }),
+                Err(e) if !self.past_critical => return Err(e),
+                _ => {}
             }
             self.checked_dt = dt;
             let fresh = (self.n_circles, self.n_bodies) != shape || self.ref_pos.is_empty();
