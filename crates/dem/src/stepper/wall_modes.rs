@@ -9,8 +9,9 @@
 //! both circles along it at 4e-7 m/s for ever; at half the step, or with the damping ratio at
 //! 0.25 or 0.1, every grain stopped (docs/stability.md, "Wall contacts of clumps").
 //!
-//! The check linearises the sticking contacts: generalised coordinates (x, y, θ), each contact
-//! adds k g gᵀ to the stiffness and c g gᵀ to the damping for its normal and tangential rows g,
+//! The check linearises the sticking contacts: generalised coordinates (x, y, ρθ), ρ the radius
+//! of gyration, so that all three carry the mass m; each contact adds k g gᵀ to the stiffness and
+//! c g gᵀ to the damping for its normal and tangential rows g,
 //! and the step maps (q, h v) by the 6 × 6 matrix of the kick-drift-kick scheme with the dashpot
 //! reading the half-step velocity (as [`lbdem_core::units::dem::damped_step_limit`] for one
 //! spring). A step is stable when that matrix's spectral radius is at most 1. Each body is
