@@ -206,15 +206,13 @@ mod tests {
     use super::*;
     use lbdem_dem::{Bodies, ClumpShape, Domain, Vec2};
 
-    #[test]
-    fn a_slow_layer_on_top_is_the_zone_and_its_fraction_is_exact() {
-        // Two rows of touching discs of r = 0.05 on a 0.1 grid fill the top 0.2 of a 1 x 1 box:
-        // fraction π/4 in a zone 0.2 high; a fast disc below stops the zone there. The body's
-        // area comes from its mass properties: 3.3e-10 relative off π r² (measured).
+    /// Rows of touching discs (r = 0.05 on a 0.1 grid) from the top of a 1 x 1 box down, disc i
+    /// of row `row` kept where `keep(row, i)`, and the zone of 0.1 bands from the top.
+    fn rows_of_discs(rows: usize, keep: impl Fn(usize, usize) -> bool) -> (Bodies, PackedZone) {
         let mut b = Bodies::new();
         let disc = ClumpShape::disk(0.05);
-        for row in 0..2 {
-            for i in 0..10 {
+        for row in 0..rows {
+            for i in (0..10).filter(|&i| keep(row, i)) {
                 b.add(
                     &disc,
                     1.0,
@@ -224,9 +222,6 @@ mod tests {
                 .expect("valid disc");
             }
         }
-        let fast = b.add(&disc, 1.0, Vec2::new(0.5, 0.75), 0.0).expect("valid disc");
-        b.vel[fast] = Vec2::new(0.0, 1.0);
-        let sys = System::new(b, Domain::open(Vec2::ZERO, Vec2::new(1.0, 1.0)));
         let pz = PackedZone {
             top: true,
             slower_than: 0.1,
@@ -234,6 +229,19 @@ mod tests {
             lo: [0.0, 0.0],
             hi: [1.0, 1.0],
         };
+        (b, pz)
+    }
+
+    #[test]
+    fn a_slow_layer_on_top_is_the_zone_and_its_fraction_is_exact() {
+        // Two rows of touching discs fill the top 0.2 of the box: fraction π/4 in a zone 0.2
+        // high; a fast disc below stops the zone there. The body's area comes from its mass
+        // properties: 3.3e-10 relative off π r² (measured).
+        let (mut b, pz) = rows_of_discs(2, |_, _| true);
+        let disc = ClumpShape::disk(0.05);
+        let fast = b.add(&disc, 1.0, Vec2::new(0.5, 0.75), 0.0).expect("valid disc");
+        b.vel[fast] = Vec2::new(0.0, 1.0);
+        let sys = System::new(b, Domain::open(Vec2::ZERO, Vec2::new(1.0, 1.0)));
         let v = pz.sample(&sys);
         assert!((v[0] - std::f64::consts::FRAC_PI_4).abs() < 7e-10, "{v:?}");
         assert!((v[1] - 0.2).abs() < 1e-12);
@@ -248,30 +256,11 @@ mod tests {
 
     #[test]
     fn the_interior_fraction_leaves_out_the_ragged_lower_band() {
-        // Four full rows of touching discs (r = 0.05 on a 0.1 grid) under the top of a 1 x 1 box
-        // and a fifth row with every other disc: bands of 0.1 hold π/4 each, the fifth π/8. The
-        // zone's fraction falls with the ragged band; the interior (bands 2-4) stays π/4.
-        let mut b = Bodies::new();
-        let disc = ClumpShape::disk(0.05);
-        for row in 0..5 {
-            for i in (0..10).filter(|i| row < 4 || i % 2 == 0) {
-                b.add(
-                    &disc,
-                    1.0,
-                    Vec2::new(0.05 + 0.1 * i as f64, 0.95 - 0.1 * row as f64),
-                    0.0,
-                )
-                .expect("valid disc");
-            }
-        }
+        // Four full rows of touching discs under the top of the box and a fifth row with every
+        // other disc: bands of 0.1 hold π/4 each, the fifth π/8. The zone's fraction falls with
+        // the ragged band; the interior (bands 2-4) stays π/4.
+        let (b, pz) = rows_of_discs(5, |row, i| row < 4 || i % 2 == 0);
         let sys = System::new(b, Domain::open(Vec2::ZERO, Vec2::new(1.0, 1.0)));
-        let pz = PackedZone {
-            top: true,
-            slower_than: 0.1,
-            band: 0.1,
-            lo: [0.0, 0.0],
-            hi: [1.0, 1.0],
-        };
         let [fraction, height, _] = pz.sample(&sys)[..] else {
             panic!("three columns")
         };
