@@ -197,8 +197,8 @@ mod tests {
     /// 6.66e-6 s with damping ratio 0.5, stable at half that step and at ratio 0.25 and 0.1,
     /// as the runs were. An independent time-stepping of the same linear system
     /// (`scripts/wall-mode-timestep.py`) put the limit at 5.759e-6 s (ratio 0.5), 8.124e-6 s
-    /// (0.25) and 1.024e-5 s (0.1); the eigenvalue form agrees within 1e-3 (measured: the
-    /// script's finite-run bisection against the spectral radius, 2e-4 apart at most).
+    /// (0.25) and 1.024e-5 s (0.1); the eigenvalue form agrees within 5e-4 (measured 2.5e-4 at
+    /// most: the script's four digits and its finite-run bisection against the spectral radius).
     #[test]
     fn the_creeping_float_grain_is_unstable_at_table_1s_step_and_stable_at_half() {
         let (m, i) = (2.910_140_25e-9, 2.813_667_7e-18);
@@ -216,7 +216,7 @@ mod tests {
             let two: Vec<Resting> = ways.iter().filter(|w| w.arms.len() == 2).cloned().collect();
             let got = largest_stable_step(&two, m, i, &sd);
             assert!(
-                (got / python - 1.0).abs() < 1e-3,
+                (got / python - 1.0).abs() < 5e-4,
                 "zeta {zeta}: {got} vs {python}"
             );
         }
