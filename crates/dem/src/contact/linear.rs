@@ -80,14 +80,7 @@ impl ContactLaw for LinearSpringDashpot {
     }
     fn spring_dashpots(&self, _r_eff: f64, m_eff: f64) -> SpringDashpots {
         let cn = self.damping.coefficient(self.k_n, m_eff);
-        SpringDashpots {
-            normal: (self.k_n, cn),
-            tangential: if self.mu > 0.0 {
-                (self.k_t, cn * self.tangential_damping)
-            } else {
-                (0.0, 0.0)
-            },
-        }
+        SpringDashpots::frictional((self.k_n, cn), (self.k_t, cn * self.tangential_damping), self.mu)
     }
     fn linear(&self) -> Option<&LinearSpringDashpot> {
         Some(self)

@@ -77,7 +77,7 @@ pub trait ContactLaw: Sync + Send {
     fn friction(&self) -> f64;
     /// The (stiffness N/m, dashpot N s/m) pairs the law puts along the normal and along the
     /// tangent of a contact between a circle of radius `r_eff` and a body of mass `m_eff`, for
-    /// the damped step limit of a wall contact ([`crate::Stepper::wall_contact_step`]). The
+    /// the damped step limit of a wall contact ([`crate::Stepper::unstable_wall_contact`]). The
     /// default is the largest stiffness along the normal and no dashpot (laws whose dashpot the
     /// check does not model).
     fn spring_dashpots(&self, r_eff: f64, _m_eff: f64) -> SpringDashpots {
@@ -113,6 +113,17 @@ pub trait ContactLaw: Sync + Send {
 pub struct SpringDashpots {
     pub normal: (f64, f64),
     pub tangential: (f64, f64),
+}
+
+impl SpringDashpots {
+    /// A spring-dashpot law's pairs: normal (k_n, c_n), tangential (k_t, c_t) where the
+    /// tangential spring acts (μ > 0), none otherwise.
+    pub fn frictional(normal: (f64, f64), tangential: (f64, f64), mu: f64) -> Self {
+        Self {
+            normal,
+            tangential: if mu > 0.0 { tangential } else { (0.0, 0.0) },
+        }
+    }
 }
 
 /// Calls `visit` with the concrete law inside a [`Law`] (static dispatch: the callee is

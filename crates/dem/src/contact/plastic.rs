@@ -77,6 +77,9 @@ impl ElasticPlastic {
     }
 }
 
+/// Tangential dashpot as a fraction of the normal one (as the linear law's default).
+const TANGENTIAL_DAMPING: f64 = 0.5;
+
 impl ContactLaw for ElasticPlastic {
     type History = History;
     #[inline]
@@ -90,7 +93,7 @@ impl ContactLaw for ElasticPlastic {
             0.0
         };
         let ft = if self.mu > 0.0 {
-            tangential(c, h, self.k_t, 0.5 * cn, self.mu, f_n)
+            tangential(c, h, self.k_t, TANGENTIAL_DAMPING * cn, self.mu, f_n)
         } else {
             Vec2::ZERO
         };
@@ -109,14 +112,7 @@ impl ContactLaw for ElasticPlastic {
     }
     fn spring_dashpots(&self, _r_eff: f64, m_eff: f64) -> super::SpringDashpots {
         let cn = self.damping.coefficient(self.k_e, m_eff);
-        super::SpringDashpots {
-            normal: (self.k_e, cn),
-            tangential: if self.mu > 0.0 {
-                (self.k_t, 0.5 * cn)
-            } else {
-                (0.0, 0.0)
-            },
-        }
+        super::SpringDashpots::frictional((self.k_e, cn), (self.k_t, TANGENTIAL_DAMPING * cn), self.mu)
     }
     fn friction(&self) -> f64 {
         self.mu

@@ -185,7 +185,7 @@ impl Stepper {
     }
 
     /// The body whose wall contact is unstable at step `dt` with the lowest stable step, if any
-    /// is ([`wall_modes`]: each body resting on a wall by two circles or by one, its contacts
+    /// is (`stepper/wall_modes.rs`: each body resting on a wall by two circles or by one, its contacts
     /// linearised, the step's spectral radius). `None` without walls or when every body is
     /// stable. Unstable bodies are searched for their largest stable step, so the answer names
     /// the step that holds them all.
@@ -365,7 +365,7 @@ impl Stepper {
         self.kick.resize(sys.bodies.len(), Kick::default());
         if self.checked_dt != dt || (self.n_circles, self.n_bodies) != shape {
             match Self::check_step(sys, law, wall_law, dt) {
-                Err(DemError::BadTimeStep { dt }) => return Err(DemError::BadTimeStep { dt }),
+                Err(e @ DemError::BadTimeStep { .. }) => return Err(e),
                 Err(e) if !self.past_critical => return Err(e),
                 _ => {}
             }
