@@ -87,6 +87,13 @@ impl Stepper {
         self.cstate.resize(nc, CircleState::default());
         let have_ref = self.ref_pos.len() == nc;
         let refp = &self.ref_pos;
+        self.turn.resize(b.len(), (0.0, 1.0));
+        b.angle
+            .par_iter()
+            .zip(self.turn.par_iter_mut())
+            .with_min_len(4096)
+            .for_each(|(a, t)| *t = a.sin_cos());
+        let turn = &self.turn;
         self.cpos
             .par_iter_mut()
             .zip(self.carm.par_iter_mut())
@@ -99,7 +106,8 @@ impl Stepper {
                 *a = if off.x == 0.0 && off.y == 0.0 {
                     Vec2::ZERO
                 } else {
-                    off.rotated(b.angle[k])
+                    let (s, cs) = turn[k];
+                    off.rotated_sc(s, cs)
                 };
                 *x = b.pos[k] + *a;
                 *st = CircleState {

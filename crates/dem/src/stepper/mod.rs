@@ -107,6 +107,8 @@ pub struct Stepper {
     cells: CellList,
     cpos: Vec<Vec2>,
     carm: Vec<Vec2>,
+    /// Per body: sine and cosine of its angle, one `sin_cos` for all its circles.
+    turn: Vec<(f64, f64)>,
     cstate: Vec<CircleState>,
     ref_pos: Vec<Vec2>,
     /// Pairs of circle i (as the lower index) are `pair_start[i]..pair_start[i + 1]`.
