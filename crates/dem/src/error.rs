@@ -9,10 +9,10 @@ pub enum DemError {
     #[error("circle radius r = {r} must be positive and finite; fix the particle file or generator")]
     BadRadius { r: f64 },
     #[error(
-        "time step dt = {dt:e} s is above the largest accepted step {limit:e} s (the lightest grain held \
-         by six grain springs and two walls; the critical time step sqrt(m_min/k_max) is {critical:e} s \
-         with m_min = {m_min:e} kg, k_max = {k_max:e} N/m; a dense packing blows up beyond it, \
-         docs/stability.md); lower dt below {limit:e} s or soften the contacts"
+        "time step dt = {dt:e} s is above the largest accepted step {limit:.4e} s (the lightest grain held \
+         by six grain springs and two walls; the critical time step sqrt(m_min/k_max) is {critical:.4e} s \
+         with m_min = {m_min:.4e} kg, k_max = {k_max:.4e} N/m; a dense packing blows up beyond it, \
+         docs/stability.md); lower dt below {limit:.4e} s or soften the contacts"
     )]
     TimeStepTooLarge {
         dt: f64,
@@ -22,12 +22,12 @@ pub enum DemError {
         k_max: f64,
     },
     #[error(
-        "time step dt = {dt:e} s is above {limit:e} s, the largest step at which body {body} resting \
-         on a wall stays still: the contact's spring ({k_wall:e} N/m) and dashpot ({c_wall:e} N s/m) \
+        "time step dt = {dt:e} s is above {limit:.4e} s, the largest step at which body {body} resting \
+         on a wall stays still: the contact's spring ({k_wall:.4e} N/m) and dashpot ({c_wall:.4e} N s/m) \
          act off the centroid, where the grain moves like a lighter mass than the dashpot was set \
          for, and past this step the explicit dashpot overshoots every step, so grains rattle \
          against the walls or creep along them without end (docs/stability.md, \"Wall contacts of \
-         clumps\"); lower dt below {limit:e} s, or lower the wall law's damping ratio"
+         clumps\"); lower dt below {limit:.4e} s, or lower the wall law's damping ratio"
     )]
     WallContactStepTooLarge {
         dt: f64,

@@ -122,7 +122,8 @@ fn cell_list_matches_brute_force() {
     assert!(!got.is_empty());
 }
 
-/// A step above sqrt(m_min/k_max) is refused with both numbers in the message.
+/// A step above sqrt(m_min/k_max) is refused with both numbers in the message (the step as
+/// given, the critical step to four decimals).
 #[test]
 fn step_above_critical_is_refused() {
     let (mut s, law, _) = packing();
@@ -132,7 +133,7 @@ fn step_above_critical_is_refused() {
     let msg = err.to_string();
     assert!(matches!(err, DemError::TimeStepTooLarge { .. }));
     assert!(
-        msg.contains(&format!("{:e}", 1.5 * crit)) && msg.contains(&format!("{crit:e}")),
+        msg.contains(&format!("{:e}", 1.5 * crit)) && msg.contains(&format!("{crit:.4e}")),
         "{msg}"
     );
 }
