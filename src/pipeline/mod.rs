@@ -4,6 +4,7 @@
 //! every input, wall time of every stage). The runner calls stages; stages never call it.
 
 mod cache;
+mod key_parts;
 pub mod provenance;
 pub mod schema;
 
@@ -35,7 +36,9 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
     let kind = prepared.kind.clone();
     let inputs = cache::hash_inputs(&prepared.inputs)?;
     let key = cache::cache_key(&prepared.kind, &prepared.params_json, &inputs);
-    let created = !ctx.out_dir.exists();
+    // A directory that holds only an interrupted run's working directory counts as this run's:
+    // a refused `--resume` that removes the working directory removes it too.
+    let created = !ctx.out_dir.exists() || holds_only(&ctx.out_dir, PARTIAL);
     let staging = if writes_in_place(&prepared.kind) {
         ctx.out_dir.clone()
     } else if prepared.resumable {
@@ -72,18 +75,29 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
         .with_context(|| format!("cannot create output directory {}", staging.display()))?;
     if prepared.resumable {
         let key_file = staging.join(cache::KEY_FILE);
+        let parts_file = staging.join(key_parts::KEY_PARTS_FILE);
+        let parts = key_parts::KeyParts::now(&prepared.kind, &prepared.params_json, &inputs);
         if ctx.resume {
             let stored = std::fs::read_to_string(&key_file).unwrap_or_default();
             if stored.trim() != key {
+                let what = std::fs::read(&parts_file)
+                    .ok()
+                    .and_then(|b| serde_json::from_slice::<key_parts::KeyParts>(&b).ok())
+                    .map(|old| old.changes(&parts, 6))
+                    .filter(|c| !c.is_empty())
+                    .map(|c| format!(": {}", c.join("; ")))
+                    .unwrap_or_default();
                 bail!(
-                    "--resume: the interrupted run in {} was made with other parameters, inputs or code (run key {}, \
-                     now {key}); run without --resume to start again",
+                    "--resume: the interrupted run in {} was made with other parameters, inputs or code{what} \
+                     (run key {}, now {key}); undo the change to continue it, or run without --resume to start \
+                     again",
                     staging.display(),
                     stored.trim()
                 );
             }
         } else {
             lbdem_core::atomic::write_atomic(&key_file, key.as_bytes())?;
+            lbdem_core::atomic::write_atomic(&parts_file, &serde_json::to_vec_pretty(&parts)?)?;
         }
     }
     // What the record says: the stage continued a run only if asked to and its working
@@ -128,6 +142,14 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
     result
 }
 
+/// Whether `dir` holds exactly one entry, `name`.
+fn holds_only(dir: &Path, name: &str) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        let names: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.file_name())).collect();
+        names.len() == 1 && names[0] == name
+    })
+}
+
 /// Move everything from `staging` into `out` (but the run key of a resumable stage),
 /// replacing files and directories of the same name. The files an earlier run of the stage
 /// listed and this one did not write are removed first, and the manifest moves last, so a
@@ -147,7 +169,7 @@ fn publish(staging: &Path, out: &Path) -> Result<()> {
     let mut entries: Vec<_> = std::fs::read_dir(staging)?.collect::<Result<_, _>>()?;
     entries.sort_by_key(|e| e.file_name() == MANIFEST);
     for entry in entries {
-        if entry.file_name() == cache::KEY_FILE {
+        if entry.file_name() == cache::KEY_FILE || entry.file_name() == key_parts::KEY_PARTS_FILE {
             continue;
         }
         let dest = out.join(entry.file_name());

@@ -4,7 +4,7 @@
 use super::*;
 use crate::contract::{MANIFEST, StageContext, StageOutput, StageRecord};
 use crate::registry::Prepared;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 fn writer_stage(input: PathBuf, param: i64, fail: bool) -> Prepared {
     Prepared::from_parts(
@@ -277,4 +277,104 @@ fn resumed_is_recorded_only_when_there_was_a_checkpoint_to_continue() {
         rec.resumed && on_disk(&ctx).resumed,
         "a resumed run recorded as fresh"
     );
+}
+
+/// A resumable test stage with parameters `params` that writes `a.txt`, or fails.
+fn resumable_stage(input: &Path, params: serde_json::Value, fail: bool) -> Prepared {
+    let mut p = Prepared::from_parts(
+        "test",
+        params,
+        vec![input.to_path_buf()],
+        move |c: &StageContext| {
+            if fail {
+                anyhow::bail!("the stage refused its input");
+            }
+            lbdem_core::atomic::write_atomic(&c.out_dir.join("a.txt"), b"x")?;
+            Ok(StageOutput {
+                files: vec!["a.txt".into()],
+                ..Default::default()
+            })
+        },
+    );
+    p.resumable = true;
+    p
+}
+
+/// An interrupted run left by `execute` itself: its working directory with the run key, what
+/// the key was made of, and a checkpoint.
+fn interrupted_run(ctx: &StageContext, input: &Path, params: serde_json::Value) {
+    let partial = ctx.out_dir.join(PARTIAL);
+    std::fs::create_dir_all(&partial).unwrap();
+    let inputs = cache::hash_inputs(&[input.to_path_buf()]).unwrap();
+    std::fs::write(
+        partial.join(cache::KEY_FILE),
+        cache::cache_key("test", &params, &inputs),
+    )
+    .unwrap();
+    let parts = key_parts::KeyParts::now("test", &params, &inputs);
+    std::fs::write(
+        partial.join(key_parts::KEY_PARTS_FILE),
+        serde_json::to_vec(&parts).unwrap(),
+    )
+    .unwrap();
+    std::fs::write(partial.join(CHECKPOINT), b"{}").unwrap();
+}
+
+/// `--resume` of a run made with another parameter or input says which, and keeps the
+/// interrupted run for a resume with the change undone.
+#[test]
+fn a_refused_resume_names_the_parameter_and_the_input_that_changed() {
+    let (_d, input, mut ctx) = setup();
+    interrupted_run(&ctx, &input, serde_json::json!({"set": {"run.time": 1.0}}));
+    ctx.resume = true;
+    let e = format!(
+        "{:#}",
+        execute(
+            resumable_stage(&input, serde_json::json!({"set": {"run.time": 2.0}}), false),
+            &ctx
+        )
+        .unwrap_err()
+    );
+    assert!(e.contains("parameter set.run.time (1.0 → 2.0)"), "{e}");
+    assert!(!e.contains("in.dat"), "{e}");
+    std::fs::write(&input, b"other bytes").unwrap();
+    let e = format!(
+        "{:#}",
+        execute(
+            resumable_stage(&input, serde_json::json!({"set": {"run.time": 1.0}}), false),
+            &ctx
+        )
+        .unwrap_err()
+    );
+    assert!(
+        e.contains("in.dat changed") && !e.contains("parameter set"),
+        "{e}"
+    );
+    assert!(
+        ctx.out_dir.join(PARTIAL).join(CHECKPOINT).is_file(),
+        "the interrupted run was lost"
+    );
+    // With the change undone it continues, and its key files are not published.
+    std::fs::write(&input, b"input bytes").unwrap();
+    let rec = execute(
+        resumable_stage(&input, serde_json::json!({"set": {"run.time": 1.0}}), false),
+        &ctx,
+    )
+    .unwrap();
+    assert!(rec.resumed);
+    assert!(!ctx.out_dir.join(key_parts::KEY_PARTS_FILE).exists());
+    assert!(!ctx.out_dir.join(cache::KEY_FILE).exists());
+}
+
+/// A failing resume of a run killed before its first checkpoint (its output directory holds
+/// only the working directory) leaves no empty output directory behind.
+#[test]
+fn a_failed_resume_of_a_run_without_a_checkpoint_leaves_no_directory() {
+    let (_d, input, mut ctx) = setup();
+    let params = serde_json::json!({});
+    interrupted_run(&ctx, &input, params.clone());
+    std::fs::remove_file(ctx.out_dir.join(PARTIAL).join(CHECKPOINT)).unwrap();
+    ctx.resume = true;
+    assert!(execute(resumable_stage(&input, params, true), &ctx).is_err());
+    assert!(!ctx.out_dir.exists(), "an empty output directory was left behind");
 }
