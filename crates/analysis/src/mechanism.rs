@@ -107,6 +107,15 @@ impl DynamicDilatancy {
             Class::Contraction
         }
     }
+    /// Whether a run's net volumetric strain ε_vol^DEM (Eq. 18) has the sign Eq. 21 predicts.
+    /// The law is about net contraction against net dilation, so a run's class (where cracking
+    /// takes precedence over the sign) is not what it is checked against.
+    pub fn agrees(&self, f0: f64, i: f64, eps_vol_net: f64) -> bool {
+        match self.predicts(f0, i) {
+            Class::Dilation => eps_vol_net > 0.0,
+            _ => eps_vol_net < 0.0,
+        }
+    }
 }
 
 /// One experiment of Fig. 3j.
@@ -358,6 +367,10 @@ mod tests {
         assert_eq!(d.predicts(0.84, 0.002), Class::Dilation);
         assert_eq!(d.predicts(0.80, 0.002), Class::Contraction);
         assert_eq!(d.predicts(0.80, 0.1), Class::Dilation);
+        // A dense sample that contracted does not agree, whatever its class.
+        assert!(d.agrees(0.84, 0.002, 0.01) && !d.agrees(0.84, 0.002, -0.016));
+        assert!(d.agrees(0.80, 0.002, -0.03) && !d.agrees(0.80, 0.002, 0.01));
+        assert!(!d.agrees(0.84, 0.002, f64::NAN) && !d.agrees(0.80, 0.002, f64::NAN));
     }
 
     /// The lines fitted to the paper's datasets say what Sect. 3.1 says of Fig. 3j: every named

@@ -410,7 +410,7 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
             "critical_packing": law.critical(i),
             "initial_packing": f,
             "predicts": law.predicts(f, i),
-            "agrees_with_run": class.map(|c| matches!((law.predicts(f, i), c), (Class::Dilation, Class::Dilation | Class::Cracking) | (Class::Contraction, Class::Contraction))),
+            "agrees_with_run": run.plate.map(|_| law.agrees(f, i, eps_net)),
         })),
         _ => None,
     };
