@@ -232,36 +232,9 @@ fn a_panicking_stage_becomes_an_error_and_leaves_nothing_behind() {
 #[test]
 fn resumed_is_recorded_only_when_there_was_a_checkpoint_to_continue() {
     let (_d, input, mut ctx) = setup();
-    let stage = || {
-        let mut p = Prepared::from_parts(
-            "test",
-            serde_json::json!({}),
-            vec![input.clone()],
-            |c: &StageContext| {
-                lbdem_core::atomic::write_atomic(&c.out_dir.join("a.txt"), b"x")?;
-                Ok(StageOutput {
-                    files: vec!["a.txt".into()],
-                    ..Default::default()
-                })
-            },
-        );
-        p.resumable = true;
-        p
-    };
-    let key = cache::cache_key(
-        "test",
-        &serde_json::json!({}),
-        &cache::hash_inputs(std::slice::from_ref(&input)).unwrap(),
-    );
-    let interrupted = |checkpoint: bool| {
-        let partial = ctx.out_dir.join(PARTIAL);
-        std::fs::create_dir_all(&partial).unwrap();
-        std::fs::write(partial.join(cache::KEY_FILE), &key).unwrap();
-        if checkpoint {
-            std::fs::write(partial.join(crate::contract::CHECKPOINT), b"{}").unwrap();
-        }
-    };
+    let stage = || resumable_stage(&input, serde_json::json!({}), false);
     ctx.resume = true;
+    let interrupted = |checkpoint| interrupted_run(&ctx, &input, serde_json::json!({}), checkpoint);
     let on_disk = |ctx: &StageContext| -> StageRecord {
         serde_json::from_slice(&std::fs::read(ctx.out_dir.join(MANIFEST)).unwrap()).unwrap()
     };
@@ -300,9 +273,9 @@ fn resumable_stage(input: &Path, params: serde_json::Value, fail: bool) -> Prepa
     p
 }
 
-/// An interrupted run left by `execute` itself: its working directory with the run key, what
-/// the key was made of, and a checkpoint.
-fn interrupted_run(ctx: &StageContext, input: &Path, params: serde_json::Value) {
+/// An interrupted run as `execute` leaves one: its working directory with the run key, what the
+/// key was made of, and (if the run got that far) a checkpoint.
+fn interrupted_run(ctx: &StageContext, input: &Path, params: serde_json::Value, checkpoint: bool) {
     let partial = ctx.out_dir.join(PARTIAL);
     std::fs::create_dir_all(&partial).unwrap();
     let inputs = cache::hash_inputs(&[input.to_path_buf()]).unwrap();
@@ -317,7 +290,9 @@ fn interrupted_run(ctx: &StageContext, input: &Path, params: serde_json::Value) 
         serde_json::to_vec(&parts).unwrap(),
     )
     .unwrap();
-    std::fs::write(partial.join(CHECKPOINT), b"{}").unwrap();
+    if checkpoint {
+        std::fs::write(partial.join(CHECKPOINT), b"{}").unwrap();
+    }
 }
 
 /// `--resume` of a run made with another parameter or input says which, and keeps the
@@ -325,27 +300,15 @@ fn interrupted_run(ctx: &StageContext, input: &Path, params: serde_json::Value) 
 #[test]
 fn a_refused_resume_names_the_parameter_and_the_input_that_changed() {
     let (_d, input, mut ctx) = setup();
-    interrupted_run(&ctx, &input, serde_json::json!({"set": {"run.time": 1.0}}));
+    interrupted_run(&ctx, &input, serde_json::json!({"set": {"run.time": 1.0}}), true);
     ctx.resume = true;
-    let e = format!(
-        "{:#}",
-        execute(
-            resumable_stage(&input, serde_json::json!({"set": {"run.time": 2.0}}), false),
-            &ctx
-        )
-        .unwrap_err()
-    );
+    let stage = |time: f64| resumable_stage(&input, serde_json::json!({"set": {"run.time": time}}), false);
+    let refusal = |time: f64| format!("{:#}", execute(stage(time), &ctx).unwrap_err());
+    let e = refusal(2.0);
     assert!(e.contains("parameter set.run.time (1.0 → 2.0)"), "{e}");
     assert!(!e.contains("in.dat"), "{e}");
     std::fs::write(&input, b"other bytes").unwrap();
-    let e = format!(
-        "{:#}",
-        execute(
-            resumable_stage(&input, serde_json::json!({"set": {"run.time": 1.0}}), false),
-            &ctx
-        )
-        .unwrap_err()
-    );
+    let e = refusal(1.0);
     assert!(
         e.contains("in.dat changed") && !e.contains("parameter set"),
         "{e}"
@@ -356,11 +319,7 @@ fn a_refused_resume_names_the_parameter_and_the_input_that_changed() {
     );
     // With the change undone it continues, and its key files are not published.
     std::fs::write(&input, b"input bytes").unwrap();
-    let rec = execute(
-        resumable_stage(&input, serde_json::json!({"set": {"run.time": 1.0}}), false),
-        &ctx,
-    )
-    .unwrap();
+    let rec = execute(stage(1.0), &ctx).unwrap();
     assert!(rec.resumed);
     assert!(!ctx.out_dir.join(key_parts::KEY_PARTS_FILE).exists());
     assert!(!ctx.out_dir.join(cache::KEY_FILE).exists());
@@ -372,8 +331,7 @@ fn a_refused_resume_names_the_parameter_and_the_input_that_changed() {
 fn a_failed_resume_of_a_run_without_a_checkpoint_leaves_no_directory() {
     let (_d, input, mut ctx) = setup();
     let params = serde_json::json!({});
-    interrupted_run(&ctx, &input, params.clone());
-    std::fs::remove_file(ctx.out_dir.join(PARTIAL).join(CHECKPOINT)).unwrap();
+    interrupted_run(&ctx, &input, params.clone(), false);
     ctx.resume = true;
     assert!(execute(resumable_stage(&input, params, true), &ctx).is_err());
     assert!(!ctx.out_dir.exists(), "an empty output directory was left behind");
