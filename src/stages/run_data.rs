@@ -10,6 +10,7 @@ use crate::scenes::schema::{Loaded, WallRef};
 use crate::scenes::snapshot::{ParticleTable, read_contacts, read_particles};
 use anyhow::{Context, Result, bail};
 use lbdem_analysis::P2;
+use polars::prelude::{BooleanChunked, DataFrame};
 use std::path::{Path, PathBuf};
 
 /// The index of a run's snapshot files (written by the snapshot observer).
@@ -344,7 +345,10 @@ impl Run {
             .collect();
         let plate = plate_of(&scene)?;
         let sp = dir.join(crate::scenes::observers::SERIES_FILE);
-        let series = read_table(&sp).ok().map(|df| (sp, df));
+        let series = match read_table(&sp) {
+            Ok(df) => Some((sp.clone(), sheared_rows(df, &sp)?)),
+            Err(_) => None,
+        };
         Ok(Self {
             dir: dir.to_path_buf(),
             scene,
@@ -414,6 +418,16 @@ impl Run {
     /// The grains the run started from: the scene's particle file when it holds the same clumps
     /// (the run wrote no snapshot at step 0), else `None`.
     pub fn initial_grains(&self, like: &Grains) -> Option<Grains> {
+        // After a settling the shear starts from the settled grains, not from the file.
+        if self
+            .scene
+            .scene
+            .shear_cell
+            .as_ref()
+            .is_some_and(|c| c.settle > 0.0)
+        {
+            return None;
+        }
         let p = self.scene.scene.particles.as_ref()?.csv.as_ref()?;
         let path = self.scene.base_dir.join(p);
         if !path.is_file() {
@@ -449,6 +463,18 @@ impl Run {
             })
             .unwrap_or(0.0)
     }
+}
+
+/// The rows of a run's series after the shear cell's settling (`settling` = 0): the analysis
+/// measures the shear, from the settled state on (`[shear_cell] settle`).
+fn sheared_rows(df: DataFrame, path: &Path) -> Result<DataFrame> {
+    if df.column("settling").is_err() {
+        return Ok(df);
+    }
+    let settling = f64_column(&df, "settling", path)?;
+    let keep: BooleanChunked = settling.iter().map(|&v| v == 0.0).collect();
+    df.filter(&keep)
+        .with_context(|| format!("cannot select the rows after the settling in {}", path.display()))
 }
 
 /// Linear interpolation of (x, y) at `x0` (x ascending); clamped at the ends.

@@ -193,7 +193,8 @@ impl<T: Real> CoupledModel<T> {
             .context("cannot start the thread pool")?;
         // A resumed run takes the plate, the origin and the wall starts from its checkpoint.
         shear_cell::clear_plate_noting(s, &mut run.sys)?;
-        let cell = Tracked::start(s, &run.sys)?;
+        let dt = run.units.dt();
+        let cell = Tracked::start(s, &mut run.sys, dt)?;
         if let (Some(c), Some(sc)) = (&cell, &s.shear_cell)
             && sc.confine_liquid
         {
@@ -286,7 +287,12 @@ impl<T: Real> Model for CoupledModel<T> {
         let run = &mut self.run;
         self.pool
             .install(|| run.step())
-            .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))
+            .map_err(|e| anyhow::anyhow!("coupled scene: {e}"))?;
+        let steps = self.steps_done();
+        if let Some(c) = &mut self.cell {
+            c.after_step(&mut self.run.sys, steps);
+        }
+        Ok(())
     }
     fn steps_done(&self) -> u64 {
         self.run.sys.step / u64::from(self.run.units.ratio)
@@ -358,7 +364,7 @@ impl<T: Real> Model for CoupledModel<T> {
         ]);
         v.extend(self.dp_min_site(&dp));
         if let Some(c) = &self.cell {
-            v.extend(c.sample(&run.sys, run.dem_stepper()));
+            v.extend(c.sample(&run.sys, run.dem_stepper(), self.steps_done()));
         }
         if let Some(z) = &self.zone {
             v.extend(z.sample(&run.sys));
@@ -376,7 +382,11 @@ impl<T: Real> Model for CoupledModel<T> {
             Probe::MaxGrainSpeed => Some(self.run.sys.bodies.max_speed()),
             Probe::WallDisplacement(k) => {
                 let w = self.run.sys.walls.get(k)?;
-                Some((wall_anchor(w) - self.wall_start[k]).norm())
+                let d = (wall_anchor(w) - self.wall_start[k]).norm();
+                match &self.cell {
+                    Some(c) => c.probe_displacement(k, self.steps_done(), d),
+                    None => Some(d),
+                }
             }
             Probe::MeanLiquidSpeed => Some(self.liquid_speeds().0),
             Probe::SteadySince => None,
@@ -420,7 +430,9 @@ impl<T: Real> Model for CoupledModel<T> {
         Ok(out)
     }
     fn progress_note(&self) -> Option<String> {
-        self.cell.as_ref().map(|c| c.note(&self.run.sys))
+        self.cell
+            .as_ref()
+            .map(|c| c.note(&self.run.sys, self.steps_done()))
     }
     fn describe(&self) -> serde_json::Value {
         let tm = self.run.timing;

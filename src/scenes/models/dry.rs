@@ -73,7 +73,7 @@ impl Dry {
             shear_cell::clear_plate_noting(s, &mut sys)?;
         }
         let wall_start = sys.walls.iter().map(wall_anchor).collect();
-        let cell = Tracked::start(s, &sys)?;
+        let cell = Tracked::start(s, &mut sys, params.dt)?;
         Ok(Self {
             sys,
             stepper,
@@ -127,7 +127,12 @@ impl Model for Dry {
     fn step(&mut self, _fields: bool) -> Result<()> {
         self.stepper
             .step_law(&self.params, &self.law, &self.wall_law, &mut self.sys)
-            .map_err(|e| anyhow::anyhow!("{e} (set [dem] dt in the scene file)"))
+            .map_err(|e| anyhow::anyhow!("{e} (set [dem] dt in the scene file)"))?;
+        let steps = self.sys.step;
+        if let Some(c) = &mut self.cell {
+            c.after_step(&mut self.sys, steps);
+        }
+        Ok(())
     }
     fn steps_done(&self) -> u64 {
         self.sys.step
@@ -151,7 +156,7 @@ impl Model for Dry {
     fn sample(&self) -> Vec<f64> {
         let mut v = grain_sample(&self.sys, &self.stepper);
         if let Some(c) = &self.cell {
-            v.extend(c.sample(&self.sys, &self.stepper));
+            v.extend(c.sample(&self.sys, &self.stepper, self.sys.step));
         }
         if let Some(z) = &self.zone {
             v.extend(z.sample(&self.sys));
@@ -169,7 +174,11 @@ impl Model for Dry {
             Probe::MaxGrainSpeed => Some(self.sys.bodies.max_speed()),
             Probe::WallDisplacement(k) => {
                 let w = self.sys.walls.get(k)?;
-                Some((wall_anchor(w) - self.wall_start[k]).norm())
+                let d = (wall_anchor(w) - self.wall_start[k]).norm();
+                match &self.cell {
+                    Some(c) => c.probe_displacement(k, self.sys.step, d),
+                    None => Some(d),
+                }
             }
             Probe::MeanLiquidSpeed | Probe::SteadySince => None,
         }
@@ -183,7 +192,7 @@ impl Model for Dry {
         )
     }
     fn progress_note(&self) -> Option<String> {
-        self.cell.as_ref().map(|c| c.note(&self.sys))
+        self.cell.as_ref().map(|c| c.note(&self.sys, self.sys.step))
     }
     fn describe(&self) -> serde_json::Value {
         serde_json::json!({

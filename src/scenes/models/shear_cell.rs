@@ -3,6 +3,13 @@
 //! and ε_vol^DEM = ln(A_def/A_0) (Eq. 18: the polygon through the membrane grains' centroids
 //! minus the plate's penetration), the mean effective stress p' of the grains (from the DEM
 //! stress tensor) and the inertial number of Eq. 20.
+//!
+//! With `[shear_cell] settle`, the plate is held still for that long first, and A_0 and the
+//! plate's origin are taken when it starts to move. The assemblies are relaxed inside the
+//! sample's walls and the membrane goes on unstressed (docs/su2020.md), so without it the
+//! sample expands against the membrane in the run's first second: ε_vol^DEM +0.015 (84 %PK) to
+//! +0.05 (95 %PK) before the plate has moved 0.3 d̄ in the 30 µm/s runs, counted as
+//! shear-induced dilation.
 
 use crate::scenes::run::wall_index;
 use crate::scenes::schema::Scene;
@@ -10,7 +17,8 @@ use anyhow::{Result, bail};
 use lbdem_dem::polygon::{plate_region, sample_area};
 use lbdem_dem::{Stepper, System, Vec2, Vector, WallMotion, WallShape};
 
-pub const COLUMNS: [&str; 7] = [
+pub const COLUMNS: [&str; 8] = [
+    "settling",
     "plate_displacement",
     "plate_displacement_d",
     "plate_force",
@@ -194,12 +202,14 @@ impl ShearCell {
         self.speed
     }
 
-    /// One series row ([`COLUMNS`]); `a0` is the sample area at the start.
-    pub fn sample(&self, sys: &System, st: &Stepper, start: Vec2, a0: f64) -> Vec<f64> {
+    /// One series row ([`COLUMNS`]); `a0` is the sample area at the start, `settling` whether
+    /// the plate is still held.
+    pub fn sample(&self, sys: &System, st: &Stepper, start: Vec2, a0: f64, settling: bool) -> Vec<f64> {
         let u = self.displacement(sys, start);
         let a = self.area(sys);
         let p = Self::mean_stress(sys, st, a);
         vec![
+            if settling { 1.0 } else { 0.0 },
             u,
             u / self.d_mean,
             // The grains push back against the plate's motion.
@@ -213,12 +223,22 @@ impl ShearCell {
 }
 
 /// A [`ShearCell`] and where it started: the plate's position and the sample's area A_0 at the
-/// start of the run (kept in checkpoints, so that a resumed run measures from the same origin).
+/// start of the shear (kept in checkpoints, so that a resumed run measures from the same
+/// origin), and the settling before it.
 #[derive(Clone, Debug)]
 pub struct Tracked {
     pub cell: ShearCell,
     pub start: Vec2,
     pub a0: f64,
+    hold: Option<Hold>,
+}
+
+/// The plate held still until the model's step `until`, then moving at `velocity`. Whether the
+/// run is settling follows from the step count, so a checkpoint needs nothing more.
+#[derive(Clone, Copy, Debug)]
+struct Hold {
+    until: u64,
+    velocity: Vec2,
 }
 
 /// The part of [`Tracked`] a checkpoint keeps.
@@ -229,16 +249,43 @@ pub struct Origin {
 }
 
 impl Tracked {
-    /// The scene's cell as the system stands now (None without `[shear_cell]`).
-    pub fn start(s: &Scene, sys: &System) -> Result<Option<Self>> {
-        Ok(ShearCell::new(s, sys)?.map(|cell| {
-            let a0 = cell.area(sys);
-            Self {
-                start: cell.plate_anchor(sys),
-                a0,
-                cell,
-            }
+    /// The scene's cell as the system stands now (None without `[shear_cell]`); with `settle`,
+    /// the plate is held for that long in steps of `dt` (s, the model's step).
+    pub fn start(s: &Scene, sys: &mut System, dt: f64) -> Result<Option<Self>> {
+        let Some(cell) = ShearCell::new(s, sys)? else {
+            return Ok(None);
+        };
+        let hold = settle_steps(s, dt).map(|until| {
+            // Held by its velocity alone: its motion still says which side is behind it.
+            let w = &mut sys.walls[cell.plate];
+            let velocity = w.vel;
+            w.vel = Vec2::ZERO;
+            Hold { until, velocity }
+        });
+        let a0 = cell.area(sys);
+        Ok(Some(Self {
+            start: cell.plate_anchor(sys),
+            a0,
+            cell,
+            hold,
         }))
+    }
+
+    /// Whether the plate is still held after `steps` steps of the model.
+    pub fn settling(&self, steps: u64) -> bool {
+        self.hold.is_some_and(|h| steps < h.until)
+    }
+
+    /// After each step of the model: at the end of the settling, set the plate moving and take
+    /// A_0 and the plate's origin from the settled sample.
+    pub fn after_step(&mut self, sys: &mut System, steps: u64) {
+        if let Some(h) = self.hold
+            && steps == h.until
+        {
+            sys.walls[self.cell.plate].vel = h.velocity;
+            self.start = self.cell.plate_anchor(sys);
+            self.a0 = self.cell.area(sys);
+        }
     }
     pub fn origin(&self) -> Origin {
         Origin {
@@ -250,12 +297,28 @@ impl Tracked {
         self.start = o.start;
         self.a0 = o.a0;
     }
-    pub fn sample(&self, sys: &System, st: &Stepper) -> Vec<f64> {
-        self.cell.sample(sys, st, self.start, self.a0)
+    pub fn sample(&self, sys: &System, st: &Stepper, steps: u64) -> Vec<f64> {
+        self.cell
+            .sample(sys, st, self.start, self.a0, self.settling(steps))
     }
-    /// "u_y = 2.41 d̄" for the progress bar.
-    pub fn note(&self, sys: &System) -> String {
+
+    /// The plate's displacement for the stop and snapshot conditions: none while it is held, so
+    /// that a snapshot `when` the displacement crosses 0 is written as the shear starts.
+    pub fn probe_displacement(&self, wall: usize, steps: u64, measured: f64) -> Option<f64> {
+        (wall != self.cell.plate || !self.settling(steps)).then_some(measured)
+    }
+    /// "u_y = 2.41 d̄" for the progress bar ("settling" while the plate is held).
+    pub fn note(&self, sys: &System, steps: u64) -> String {
+        if self.settling(steps) {
+            return "settling, plate held".into();
+        }
         let u = self.cell.displacement(sys, self.start);
         format!("u_y = {:.2} d̄", u / self.cell.d_mean)
     }
+}
+
+/// `[shear_cell] settle` in steps of `dt` (None when 0 or without `[shear_cell]`).
+pub fn settle_steps(s: &Scene, dt: f64) -> Option<u64> {
+    let t = s.shear_cell.as_ref()?.settle;
+    (t > 0.0).then(|| (t / dt).round().max(1.0) as u64)
 }

@@ -263,6 +263,11 @@ const RULES: &[Rule] = &[
         Need::Positive,
         "shear length (m; Su: 0.01)",
     ),
+    Rule(
+        "shear_cell.settle",
+        Need::NonNegative,
+        "time with the plate held before it moves (s; 0 = none)",
+    ),
     Rule("packed_zone.band", Need::Positive, "band thickness (m)"),
     Rule("packed_zone.slower_than", Need::Positive, "speed threshold (m/s)"),
     Rule("fluid.density", Need::Positive, "liquid density (kg/m³)"),

@@ -18,6 +18,12 @@ pub struct ShearCellSection {
     /// zone" of Fig. 2 step 15, rebuilt every LBM step (default true).
     #[serde(default = "yes")]
     pub confine_liquid: bool,
+    /// Seconds with the plate held still before it moves (default 0): the grains come to rest
+    /// against the membrane with the run's own contact law and liquid, as Su et al. relax the
+    /// assembly inside the membrane before deformation (Sect. 2.4). A_0 of Eq. 18 and the
+    /// plate's displacement are measured from the end of it; `[run] time` counts after it.
+    #[serde(default)]
+    pub settle: f64,
 }
 
 fn ten_mm() -> f64 {

@@ -190,12 +190,13 @@ fn an_interrupted_shear_cell_run_resumes_to_the_same_bits() {
     // With the solid map kept between steps (a tolerance above 0), the state a resume needs
     // includes where each grain was last mapped; at 0 the map is recomputed from the grains
     // (`remap::tests::at_tolerance_zero_it_gives_the_bits_of_a_fresh_map`).
+    // The plate held for the first 12 steps: checkpoints fall inside the settling and after it.
     let text = cell(&whole, |s| {
-        shorter("0.03")(s)
+        settled("0.006")(shorter("0.03")(s))
             .replace("[output]\n", "[output]\ncheckpoints = { every = 5 }\n")
             .replace("r_hd = 0.8 ", "remap_tolerance = 0.02\nr_hd = 0.8 ")
     });
-    assert!(text.contains("remap_tolerance"));
+    assert!(text.contains("remap_tolerance") && text.contains("settle"));
     simulate(&text, &whole, false).unwrap();
     let cut = t.path().join("cut");
     cell(&cut, |s| s);
@@ -207,6 +208,77 @@ fn an_interrupted_shear_cell_run_resumes_to_the_same_bits() {
     let a = std::fs::read(last_snapshot(&whole.join("out"), "fluid")).unwrap();
     let b = std::fs::read(last_snapshot(&cut.join("out"), "fluid")).unwrap();
     assert!(a == b, "the last fluid snapshot differs");
+}
+
+/// The plate held for `time` seconds before it moves (`[shear_cell] settle`), and a snapshot as
+/// it starts to move.
+fn settled(time: &str) -> impl Fn(String) -> String {
+    let time = time.to_string();
+    move |t: String| {
+        t.replace(
+            "[shear_cell]\nplate = \"plate\"\n",
+            &format!("[shear_cell]\nplate = \"plate\"\nsettle = {time}\n"),
+        )
+        .replace(
+            "snapshots = { count = 2 }",
+            "snapshots = { when = { quantity = \"wall_displacement\", wall = \"plate\", crosses = [0.0, 1.0e-5] } }",
+        )
+    }
+}
+
+/// `[shear_cell] settle`: the plate stays still while the grains settle against the membrane,
+/// then moves for `[run] time`; ε_vol^DEM and the plate's displacement start from the settled
+/// sample, a snapshot is written as the plate starts, and the analysis reads the shear only.
+#[test]
+fn a_settling_holds_the_plate_and_the_shear_is_measured_from_the_settled_sample() {
+    let t = tempfile::tempdir().unwrap();
+    // 0.01 s held (20 LBM steps of 5e-4 s), then 0.01 s moving at 2.5 mm/s. The committed
+    // assembly is at rest (1e-17 m/s), so the grains start towards the plate at 2 mm/s to have
+    // something to settle.
+    let text = cell(t.path(), |s| {
+        settled("0.01")(shorter("0.01")(s))
+            .replace("[particles]\n", "[particles]\nvelocity = [0.0, -2.0e-3]\n")
+    });
+    assert!(
+        text.contains("settle = 0.01")
+            && text.contains("crosses = [0.0, 1.0e-5]")
+            && text.contains("-2.0e-3")
+    );
+    let rec = simulate(&text, t.path(), false).unwrap();
+    let out = t.path().join("out");
+    assert_eq!(rec.output.summary["steps"], 40, "{}", rec.output.summary);
+    let (step, settling) = (column(&out, "step"), column(&out, "settling"));
+    let (u, eps) = (column(&out, "plate_displacement"), column(&out, "eps_vol_dem"));
+    for k in 0..step.len() {
+        assert_eq!(settling[k], if step[k] < 20.0 { 1.0 } else { 0.0 }, "row {k}");
+        if step[k] <= 20.0 {
+            assert_eq!(u[k], 0.0, "the plate moved at step {}", step[k]);
+        }
+        if step[k] == 20.0 {
+            assert_eq!(eps[k], 0.0, "A_0 is the settled sample's area");
+        }
+    }
+    // Measured: ε_vol^DEM +1.9e-5 at step 15 (from the file's grains), the plate still.
+    let held = eps[step.iter().position(|&s| s == 15.0).unwrap()];
+    assert!(held != 0.0, "the grains did not move while the plate was held");
+    let moved = *u.last().unwrap();
+    assert!(
+        (moved - 0.01 * 2.5e-3).abs() < 1e-9,
+        "the plate moved {moved:e} m in the 0.01 s after the settling"
+    );
+    // The snapshot of the settled sample, one step after the plate starts.
+    let index = std::fs::read_to_string(out.join("snapshots.csv")).unwrap();
+    assert!(index.contains("\n21,"), "{index}");
+
+    // The analysis reads the shear: no settling rows, and the settled grains as reference.
+    let run = crate::stages::run_data::Run::open(&out, Some(&t.path().join("scene/scene.toml"))).unwrap();
+    assert!(run.series("settling").unwrap().iter().all(|&s| s == 0.0));
+    assert_eq!(run.series("step").unwrap()[0], 20.0);
+    let first = run.grains(21).unwrap();
+    assert!(
+        run.initial_grains(&first).is_none(),
+        "the file's grains are not the settled ones"
+    );
 }
 
 /// The cell without its liquid (Su Fig. 11, right column: "LBM turned off").
