@@ -136,6 +136,8 @@ pub struct Run {
     pub snapshots: Vec<SnapshotEntry>,
     pub plate: Option<Plate>,
     series: Option<(PathBuf, polars::prelude::DataFrame)>,
+    /// Whether the series holds rows of a settling before the shear (`[shear_cell] settle`).
+    settled: bool,
 }
 
 /// One clump of a particle snapshot.
@@ -345,9 +347,12 @@ impl Run {
             .collect();
         let plate = plate_of(&scene)?;
         let sp = dir.join(crate::scenes::observers::SERIES_FILE);
-        let series = match read_table(&sp) {
-            Ok(df) => Some((sp.clone(), sheared_rows(df, &sp)?)),
-            Err(_) => None,
+        let (series, settled) = match read_table(&sp) {
+            Ok(df) => {
+                let (df, settled) = sheared_rows(df, &sp)?;
+                (Some((sp.clone(), df)), settled)
+            }
+            Err(_) => (None, false),
         };
         Ok(Self {
             dir: dir.to_path_buf(),
@@ -355,6 +360,7 @@ impl Run {
             snapshots,
             plate,
             series,
+            settled,
         })
     }
 
@@ -418,14 +424,9 @@ impl Run {
     /// The grains the run started from: the scene's particle file when it holds the same clumps
     /// (the run wrote no snapshot at step 0), else `None`.
     pub fn initial_grains(&self, like: &Grains) -> Option<Grains> {
-        // After a settling the shear starts from the settled grains, not from the file.
-        if self
-            .scene
-            .scene
-            .shear_cell
-            .as_ref()
-            .is_some_and(|c| c.settle > 0.0)
-        {
+        // After a settling the shear starts from the settled grains, not from the file. The
+        // series says whether the run settled (its scene file may have changed since).
+        if self.settled {
             return None;
         }
         let p = self.scene.scene.particles.as_ref()?.csv.as_ref()?;
@@ -466,15 +467,19 @@ impl Run {
 }
 
 /// The rows of a run's series after the shear cell's settling (`settling` = 0): the analysis
-/// measures the shear, from the settled state on (`[shear_cell] settle`).
-fn sheared_rows(df: DataFrame, path: &Path) -> Result<DataFrame> {
+/// measures the shear, from the settled state on (`[shear_cell] settle`); and whether there
+/// were settling rows.
+fn sheared_rows(df: DataFrame, path: &Path) -> Result<(DataFrame, bool)> {
     if df.column("settling").is_err() {
-        return Ok(df);
+        return Ok((df, false));
     }
     let settling = f64_column(&df, "settling", path)?;
     let keep: BooleanChunked = settling.iter().map(|&v| v == 0.0).collect();
-    df.filter(&keep)
-        .with_context(|| format!("cannot select the rows after the settling in {}", path.display()))
+    let settled = settling.iter().any(|&v| v != 0.0);
+    let df = df
+        .filter(&keep)
+        .with_context(|| format!("cannot select the rows after the settling in {}", path.display()))?;
+    Ok((df, settled))
 }
 
 /// Linear interpolation of (x, y) at `x0` (x ascending); clamped at the ends.
