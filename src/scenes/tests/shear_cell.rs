@@ -1,7 +1,8 @@
 //! The reduced Su et al. 2020 shear cell (`scenes/su2020/reduced-shear-cell.toml`: 300 grains,
 //! the push-plate moving up by about one mean diameter): what a case this small can show. The
 //! plate compacts the grains ahead of it, the liquid stays inside the membrane and its mass
-//! follows the sample's area, Δp is lowest just above the plate, the run is the same on one
+//! follows the sample's area, Δp is lowest just above the plate (the resting solid zone's
+//! artefact, docs/su2020.md), the run is the same on one
 //! and two threads and after an interruption, the same cell without liquid records the same
 //! measures, and bad set-ups are refused before anything runs.
 
@@ -144,10 +145,10 @@ fn the_plate_compacts_the_grains_ahead_and_the_liquid_stays_inside_the_membrane(
     );
 
     // The liquid's pressure falls most just above the plate (within its width, 1.5 mm above
-    // it; Su et al. 2020 Sect. 4 place the first critical drop "adjacent to or above the
-    // top-right corner of the push-plate", a finer statement this window does not test):
-    // the resting solid zone under the rising membrane takes liquid the grains above draw
-    // after them. Measured at the end: lowest Δp −6.4 Pa at x 4.15 mm (the plate spans 3-5
+    // it): the resting solid zone under the rising membrane takes liquid the grains above draw
+    // after them. That is an artefact of the zone at rest, not Su's physics (docs/su2020.md,
+    // "This is an artefact"): issue 13 item 9 asks that Δp rise ahead of a compacting plate.
+    // This pins where the artefact acts today, so that a fix shows here. Measured at the end: lowest Δp −6.4 Pa at x 4.15 mm (the plate spans 3-5
     // mm), 0.48 mm above the plate.
     let (x, y) = (
         *column(&out, "dp_min_x").last().unwrap(),
