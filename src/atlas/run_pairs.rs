@@ -4,7 +4,7 @@
 //! a pipeline's stages. One realisation each, so the bound of a shift is the shift itself.
 
 use super::studies::Shift;
-use crate::report::table::{f64_column, read_table};
+use crate::report::table::f64_column;
 use anyhow::{Context, Result, bail};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -81,7 +81,7 @@ fn load(dir: &Path, result: &str) -> Result<Run> {
             dir.display()
         );
     }
-    let df = read_table(&series)?;
+    let df = crate::stages::run_data::read_series(&series)?;
     let value = f64_column(&df, result, &series)?;
     if value.is_empty() {
         bail!("{}: no rows; the run wrote no time series", series.display());

@@ -466,6 +466,12 @@ impl Run {
     }
 }
 
+/// A run's series as everything after the run reads it: the rows after the shear cell's
+/// settling ([`sheared_rows`]).
+pub fn read_series(path: &Path) -> Result<DataFrame> {
+    Ok(sheared_rows(read_table(path)?, path)?.0)
+}
+
 /// The rows of a run's series after the shear cell's settling (`settling` = 0): the analysis
 /// measures the shear, from the settled state on (`[shear_cell] settle`); and whether there
 /// were settling rows.

@@ -55,7 +55,12 @@ pub fn extract(spec: &ResultSpec, case_dir: &Path, stages: &[(String, String)]) 
             .clone()
             .unwrap_or_else(|| crate::scenes::observers::SERIES_FILE.into()),
     );
-    let df = read_table(&table)?;
+    // A run's series without the shear cell's settling rows, as the analysis reads it.
+    let df = if table.file_name() == Some(std::ffi::OsStr::new(crate::scenes::observers::SERIES_FILE)) {
+        crate::stages::run_data::read_series(&table)?
+    } else {
+        read_table(&table)?
+    };
     let y = f64_column(&df, column, &table)?;
     let v = match &spec.at {
         Some(At { column: xc, value }) => {

@@ -275,6 +275,9 @@ fn a_settling_holds_the_plate_and_the_shear_is_measured_from_the_settled_sample(
     let run = crate::stages::run_data::Run::open(&out, Some(&t.path().join("scene/scene.toml"))).unwrap();
     assert!(run.series("settling").unwrap().iter().all(|&s| s == 0.0));
     assert_eq!(run.series("step").unwrap()[0], 20.0);
+    // The sweeps' results and the atlas's run pairs read the series the same way.
+    let sheared = crate::stages::run_data::read_series(&out.join("series.csv")).unwrap();
+    assert_eq!(sheared.height(), run.series("step").unwrap().len());
     let first = run.grains(21).unwrap();
     assert!(
         run.initial_grains(&first).is_none(),
