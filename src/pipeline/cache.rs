@@ -1,7 +1,7 @@
 //! Content-hash cache: a stage is skipped when its kind, parameters, input bytes and the
 //! code version hash to the key stored in its manifest and every output it listed exists.
 
-use crate::contract::{InputHash, MANIFEST, StageContext, StageRecord, code_version};
+use crate::contract::{InputHash, MANIFEST, StageContext, StageRecord};
 use crate::registry::Prepared;
 use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
@@ -53,18 +53,9 @@ pub fn hash_inputs(paths: &[PathBuf]) -> Result<Vec<InputHash>> {
     Ok(out)
 }
 
+/// The key of a stage run: [`super::key_parts::KeyParts::key`] of its parts now.
 pub fn cache_key(kind: &str, params: &serde_json::Value, inputs: &[InputHash]) -> String {
-    let mut h = Sha256::new();
-    for part in [code_version().as_str(), kind, &params.to_string()] {
-        h.update(part.as_bytes());
-        h.update([0]);
-    }
-    let mut sorted: Vec<&InputHash> = inputs.iter().collect();
-    sorted.sort_by(|a, b| a.path.cmp(&b.path));
-    for i in sorted {
-        h.update(i.sha256.as_bytes());
-    }
-    hex::encode(h.finalize())
+    super::key_parts::KeyParts::now(kind, params, inputs).key()
 }
 
 /// The stored record if the stage can be skipped.

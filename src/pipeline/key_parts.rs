@@ -4,12 +4,14 @@
 
 use crate::contract::{InputHash, code_version};
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 
 /// The file in a resumable stage's working directory that holds its [`KeyParts`].
 pub const KEY_PARTS_FILE: &str = "run.key.json";
 
-/// The parts [`super::cache::cache_key`] hashes.
+/// What a stage's key is made of: [`KeyParts::key`] hashes these and nothing else, so the key
+/// and the account of what changed cannot drift apart.
 #[derive(Debug, Serialize, Deserialize)]
 pub struct KeyParts {
     pub code_version: String,
@@ -26,6 +28,22 @@ impl KeyParts {
             params: params.clone(),
             inputs: inputs.to_vec(),
         }
+    }
+
+    /// SHA-256 of the code version, kind and parameters (each closed by a zero byte) and the
+    /// inputs' hashes in path order: the run key and the cache key.
+    pub fn key(&self) -> String {
+        let mut h = Sha256::new();
+        for part in [self.code_version.as_str(), &self.kind, &self.params.to_string()] {
+            h.update(part.as_bytes());
+            h.update([0]);
+        }
+        let mut sorted: Vec<&InputHash> = self.inputs.iter().collect();
+        sorted.sort_by(|a, b| a.path.cmp(&b.path));
+        for i in sorted {
+            h.update(i.sha256.as_bytes());
+        }
+        hex::encode(h.finalize())
     }
 
     /// What differs from `self` (the interrupted run's parts) in `now`, one phrase each, at

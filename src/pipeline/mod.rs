@@ -35,7 +35,8 @@ fn writes_in_place(kind: &str) -> bool {
 pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
     let kind = prepared.kind.clone();
     let inputs = cache::hash_inputs(&prepared.inputs)?;
-    let key = cache::cache_key(&prepared.kind, &prepared.params_json, &inputs);
+    let parts = key_parts::KeyParts::now(&prepared.kind, &prepared.params_json, &inputs);
+    let key = parts.key();
     // A directory that holds only an interrupted run's working directory counts as this run's:
     // a refused `--resume` that removes the working directory removes it too.
     let created = !ctx.out_dir.exists() || holds_only(&ctx.out_dir, PARTIAL);
@@ -76,7 +77,6 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
     if prepared.resumable {
         let key_file = staging.join(cache::KEY_FILE);
         let parts_file = staging.join(key_parts::KEY_PARTS_FILE);
-        let parts = key_parts::KeyParts::now(&prepared.kind, &prepared.params_json, &inputs);
         if ctx.resume {
             let stored = std::fs::read_to_string(&key_file).unwrap_or_default();
             if stored.trim() != key {
