@@ -18,7 +18,7 @@ use lbdem_core::units::coupled::{LOAD_DENSITY_MAX, PSM_DENSITY_RATIO_MIN, buoyan
 use lbdem_coupling::bounce::BounceFluid;
 use lbdem_coupling::units::CouplingUnits;
 use lbdem_coupling::{Coupled, Hydro, Method, PsmFluid, PsmSettings};
-use lbdem_dem::{Vec2, Vector};
+use lbdem_dem::Vec2;
 use lbdem_lbm::{Collision, Domain, Limits, Real};
 use std::path::{Path, PathBuf};
 
@@ -380,14 +380,13 @@ impl<T: Real> Model for CoupledModel<T> {
     fn probe(&self, q: Probe) -> Option<f64> {
         match q {
             Probe::MaxGrainSpeed => Some(self.run.sys.bodies.max_speed()),
-            Probe::WallDisplacement(k) => {
-                let w = self.run.sys.walls.get(k)?;
-                let d = (wall_anchor(w) - self.wall_start[k]).norm();
-                match &self.cell {
-                    Some(c) => c.probe_displacement(k, self.steps_done(), d),
-                    None => Some(d),
-                }
-            }
+            Probe::WallDisplacement(k) => shear_cell::wall_displacement(
+                &self.run.sys,
+                &self.wall_start,
+                self.cell.as_ref(),
+                k,
+                self.steps_done(),
+            ),
             Probe::MeanLiquidSpeed => Some(self.liquid_speeds().0),
             Probe::SteadySince => None,
         }

@@ -9,7 +9,7 @@ use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::write_particles;
 use crate::scenes::timeloop::{Model, Probe};
 use anyhow::{Context, Result};
-use lbdem_dem::{Law, StepParams, Stepper, System, Vec2, Vector};
+use lbdem_dem::{Law, StepParams, Stepper, System, Vec2};
 use std::path::{Path, PathBuf};
 
 pub struct Dry {
@@ -172,14 +172,13 @@ impl Model for Dry {
     fn probe(&self, q: Probe) -> Option<f64> {
         match q {
             Probe::MaxGrainSpeed => Some(self.sys.bodies.max_speed()),
-            Probe::WallDisplacement(k) => {
-                let w = self.sys.walls.get(k)?;
-                let d = (wall_anchor(w) - self.wall_start[k]).norm();
-                match &self.cell {
-                    Some(c) => c.probe_displacement(k, self.sys.step, d),
-                    None => Some(d),
-                }
-            }
+            Probe::WallDisplacement(k) => shear_cell::wall_displacement(
+                &self.sys,
+                &self.wall_start,
+                self.cell.as_ref(),
+                k,
+                self.sys.step,
+            ),
             Probe::MeanLiquidSpeed | Probe::SteadySince => None,
         }
     }

@@ -11,11 +11,12 @@
 //! +0.05 (95 %PK) before the plate has moved 0.3 d̄ in the 30 µm/s runs, counted as
 //! shear-induced dilation.
 
+use crate::scenes::build::dem::wall_anchor;
 use crate::scenes::run::wall_index;
 use crate::scenes::schema::Scene;
 use anyhow::{Result, bail};
 use lbdem_dem::polygon::{plate_region, sample_area};
-use lbdem_dem::{Stepper, System, Vec2, Vector, WallMotion, WallShape};
+use lbdem_dem::{Stepper, System, Vec2, Vector, WallMotion};
 
 pub const COLUMNS: [&str; 8] = [
     "settling",
@@ -44,14 +45,6 @@ pub struct ShearCell {
     /// Mean equivalent-area grain diameter d̄ (m) and mean grain density (kg/m², per depth).
     pub d_mean: f64,
     rho: f64,
-}
-
-/// Where the plate's segment starts (moves with it).
-fn anchor(sys: &System, k: usize) -> Vec2 {
-    match sys.walls[k].shape {
-        WallShape::Segment { a, .. } => a,
-        WallShape::Plane { p, .. } => p,
-    }
 }
 
 /// Move the push-plate back along its motion until no grain circle overlaps it, before the
@@ -189,12 +182,12 @@ impl ShearCell {
 
     /// The plate's displacement along its motion (m) since `start`.
     pub fn displacement(&self, sys: &System, start: Vec2) -> f64 {
-        (anchor(sys, self.plate) - start).dot(self.dir)
+        (wall_anchor(&sys.walls[self.plate]) - start).dot(self.dir)
     }
 
     /// Where the plate starts now.
     pub fn plate_anchor(&self, sys: &System) -> Vec2 {
-        anchor(sys, self.plate)
+        wall_anchor(&sys.walls[self.plate])
     }
 
     /// The plate's speed du_y/dt (m/s).
@@ -304,9 +297,10 @@ impl Tracked {
 
     /// The plate's displacement for the stop and snapshot conditions: none while it is held, so
     /// that a snapshot `when` the displacement crosses 0 is written as the shear starts.
-    pub fn probe_displacement(&self, wall: usize, steps: u64, measured: f64) -> Option<f64> {
+    fn probe_displacement(&self, wall: usize, steps: u64, measured: f64) -> Option<f64> {
         (wall != self.cell.plate || !self.settling(steps)).then_some(measured)
     }
+
     /// "u_y = 2.41 d̄" for the progress bar ("settling" while the plate is held).
     pub fn note(&self, sys: &System, steps: u64) -> String {
         if self.settling(steps) {
@@ -321,4 +315,20 @@ impl Tracked {
 pub fn settle_steps(s: &Scene, dt: f64) -> Option<u64> {
     let t = s.shear_cell.as_ref()?.settle;
     (t > 0.0).then(|| (t / dt).round().max(1.0) as u64)
+}
+
+/// How far wall `k` moved from `start` (its anchor at the start of the run), for the stop and
+/// snapshot conditions of either model; none for the push-plate while it is held.
+pub fn wall_displacement(
+    sys: &System,
+    start: &[Vec2],
+    cell: Option<&Tracked>,
+    k: usize,
+    steps: u64,
+) -> Option<f64> {
+    let d = (wall_anchor(sys.walls.get(k)?) - start[k]).norm();
+    match cell {
+        Some(c) => c.probe_displacement(k, steps, d),
+        None => Some(d),
+    }
 }
