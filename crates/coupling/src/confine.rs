@@ -6,16 +6,57 @@
 //! The membrane boundary is the polygon joining the centroids of the membrane grains (the one of
 //! Eq. 18); a push-plate's solid region is the quadrilateral behind its segment
 //! (`lbdem_dem::polygon::plate_region`). Nodes behind a plate show the liquid the plate's
-//! velocity; nodes outside the polygon are at rest. They once showed the nearest membrane
-//! grain's velocity, which put momentum into the liquid that no grain paid for and ran away at
-//! the paper's densities (docs/su2020.md, "The liquid confined to the sample").
+//! velocity. Nodes outside the polygon show it either a wall at rest ([`MembraneBoundary::AtRest`],
+//! step 15 as written) or the membrane's own velocity, interpolated along the polygon's edges
+//! ([`MembraneBoundary::Moving`]). The moving boundary hands the reaction of its bounce-back to
+//! the two membrane grains of each edge, so that no momentum goes unpaid: an earlier version
+//! showed the nearest grain's velocity without the reaction and ran away at the paper's
+//! densities (docs/su2020.md, "The liquid confined to the sample"). Its bounce-back would also
+//! push the swept liquid ahead of a moving membrane and seal the sample; the mass it puts in is
+//! taken out again in proportion to every node's ([`PsmFluid::set_pull_scale`]), so the liquid's
+//! mass still follows the sample's area, as with the zone at rest.
 
 use crate::error::CouplingError;
-use crate::psm::LIQUID;
+use crate::psm::{LIQUID, Load, PsmFluid};
 use crate::units::CouplingUnits;
 use lbdem_dem::System;
 use lbdem_dem::Vec2;
 use lbdem_dem::polygon::{plate_region, scan_rows};
+use lbdem_dem::vector::Vector;
+use lbdem_lbm::Real;
+
+/// What the liquid sees outside the membrane polygon.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MembraneBoundary {
+    /// A wall at rest (Su et al. 2020 step 15 as written): a rising membrane closes over the
+    /// liquid next to it and takes it away, a sink wherever the liquid moves with it.
+    #[default]
+    AtRest,
+    /// A wall moving with the membrane (velocity interpolated along the polygon's edges), whose
+    /// reaction the membrane grains feel. Explicit: not yet stable for every assembly at the
+    /// paper's masses (docs/su2020.md, "The liquid confined to the sample").
+    Moving,
+}
+
+/// A zone node next to the membrane: the velocity index it shows, and where on which edge.
+#[derive(Clone, Copy, Debug)]
+struct EdgeNode {
+    node: usize,
+    /// Index of its velocity (the zone value).
+    index: u32,
+    /// The edge's end grains (body indices) and the node's place between them (0 at `a`).
+    a: u32,
+    b: u32,
+    /// The same grains' places in the ring.
+    ra: u32,
+    rb: u32,
+    t: f64,
+}
+
+/// How far from an edge (lattice units) its nodes are found: a zone node with a liquid
+/// neighbour lies within √2 of the polygon.
+const EDGE_REACH: f64 = 1.5;
 
 /// Which nodes hold liquid, recomputed from the grains and walls.
 #[derive(Clone, Debug)]
@@ -24,13 +65,21 @@ pub struct Confinement {
     order: Vec<usize>,
     /// Walls (indices in `System::walls`) whose region behind is solid: the push-plates.
     plates: Vec<usize>,
+    boundary: MembraneBoundary,
     zone: Vec<u32>,
     velocities: Vec<[f64; 3]>,
+    /// Zone nodes showing the membrane's velocity ([`MembraneBoundary::Moving`]).
+    edge_nodes: Vec<EdgeNode>,
+    /// Scratch: squared distance to the nearest edge found so far, and that edge (`Moving`).
+    nearest: Vec<(f64, u32, f64)>,
+    /// Where each membrane grain (ring order) was at the last call of [`Confinement::zone`]
+    /// (`Moving`): the boundary shows its mean velocity over the last LBM cycle.
+    previous: Vec<Vec2>,
 }
 
 impl Confinement {
     /// Confine the liquid to the membrane of `sys` minus the regions behind the walls `plates`.
-    pub fn new(sys: &System, plates: Vec<usize>) -> Result<Self, CouplingError> {
+    pub fn new(sys: &System, plates: Vec<usize>, boundary: MembraneBoundary) -> Result<Self, CouplingError> {
         let mem = sys.membrane.as_ref().ok_or_else(|| {
             CouplingError::Unsupported(
                 "confining the liquid needs a membrane: add [membrane] (and [bonds]) to the scene".into(),
@@ -56,14 +105,33 @@ impl Confinement {
         Ok(Self {
             order: mem.ring_order(),
             plates,
+            boundary,
             zone: Vec::new(),
             velocities: Vec::new(),
+            edge_nodes: Vec::new(),
+            nearest: Vec::new(),
+            previous: Vec::new(),
         })
+    }
+
+    pub fn boundary(&self) -> MembraneBoundary {
+        self.boundary
+    }
+
+    /// Where the membrane grains were at the last [`Confinement::zone`] (`Moving`; ring order).
+    pub fn previous(&self) -> &[Vec2] {
+        &self.previous
+    }
+
+    /// Continue from a checkpoint's [`Confinement::previous`] (empty: the grains' own velocities
+    /// for the next step).
+    pub fn set_previous(&mut self, previous: Vec<Vec2>) {
+        self.previous = previous;
     }
 
     /// The solid zone of an `nx` × `ny` lattice for the present grains and walls, and the
     /// boundary velocities it refers to (lattice units): 0 at rest (outside the membrane),
-    /// 1 + k behind plate k.
+    /// 1 + k behind plate k, and after those (`Moving`) one per zone node along the membrane.
     pub fn zone(
         &mut self,
         sys: &System,
@@ -86,16 +154,137 @@ impl Confinement {
             .map(to_lattice)
             .collect();
         fill(&ring, nx, ny, |i| self.zone[i] = LIQUID);
+        self.edge_nodes.clear();
+        let first_edge_index = 1 + self.plates.len() as u32;
+        if self.boundary == MembraneBoundary::Moving {
+            let ids: Vec<u32> = self.order.iter().map(|&k| mem.bodies[k]).collect();
+            self.edges(&ring, &ids, nx, ny, first_edge_index);
+        }
+        // One velocity per plate, then the edges' (from `first_edge_index` on).
         for (k, &w) in self.plates.iter().enumerate() {
             let wall = &sys.walls[w];
-            let Some(q) = plate_region(wall) else { continue };
             let v = units.velocity_to_lattice([wall.vel.x, wall.vel.y]);
             self.velocities.push([v[0], v[1], 0.0]);
+            let Some(q) = plate_region(wall) else { continue };
             let quad: Vec<Vec2> = q.into_iter().map(to_lattice).collect();
             let z = 1 + k as u32;
             fill(&quad, nx, ny, |i| self.zone[i] = z);
         }
+        if self.boundary == MembraneBoundary::Moving {
+            let b = &sys.bodies;
+            let now: Vec<Vec2> = self
+                .order
+                .iter()
+                .map(|&k| b.pos[mem.bodies[k] as usize])
+                .collect();
+            let dt = units.dt();
+            let mean: Vec<Vec2> = if self.previous.len() == now.len() {
+                now.iter()
+                    .zip(&self.previous)
+                    .map(|(p, q)| (*p - *q) * (1.0 / dt))
+                    .collect()
+            } else {
+                self.order
+                    .iter()
+                    .map(|&k| b.vel[mem.bodies[k] as usize])
+                    .collect()
+            };
+            self.previous = now;
+            for e in &self.edge_nodes {
+                let (va, vb) = (mean[e.ra as usize], mean[e.rb as usize]);
+                let v = va * (1.0 - e.t) + vb * e.t;
+                let v = units.velocity_to_lattice([v.x, v.y]);
+                self.velocities.push([v[0], v[1], 0.0]);
+            }
+            // A plate drawn over an edge node takes it.
+            let zone = &self.zone;
+            self.edge_nodes.retain(|e| zone[e.node] == e.index);
+        }
         (&self.zone, &self.velocities)
+    }
+
+    /// Give each zone node within [`EDGE_REACH`] of the polygon `ring` (lattice coordinates;
+    /// `ids` its grains) the nearest edge, and a velocity index from `first` on.
+    fn edges(&mut self, ring: &[Vec2], ids: &[u32], nx: usize, ny: usize, first: u32) {
+        let n = nx * ny;
+        if self.nearest.len() != n {
+            self.nearest = vec![(f64::INFINITY, 0, 0.0); n];
+        }
+        let mut touched: Vec<usize> = Vec::new();
+        let m = ring.len();
+        for e in 0..m {
+            let (a, b) = (ring[e], ring[(e + 1) % m]);
+            let ab = b - a;
+            let len2 = ab.dot(ab).max(1e-300);
+            let lo = |p: f64, q: f64| ((p.min(q) - EDGE_REACH - 0.5).floor().max(0.0)) as usize;
+            let hi = |p: f64, q: f64, n: usize| ((p.max(q) + EDGE_REACH).ceil().max(0.0) as usize).min(n);
+            for j in lo(a.y, b.y)..hi(a.y, b.y, ny) {
+                for i in lo(a.x, b.x)..hi(a.x, b.x, nx) {
+                    let idx = j * nx + i;
+                    if self.zone[idx] == LIQUID {
+                        continue;
+                    }
+                    let p = Vec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                    let t = ((p - a).dot(ab) / len2).clamp(0.0, 1.0);
+                    let d = p - (a + ab * t);
+                    let d2 = d.dot(d);
+                    let slot = &mut self.nearest[idx];
+                    if d2 < EDGE_REACH * EDGE_REACH && d2 < slot.0 {
+                        if slot.0 == f64::INFINITY {
+                            touched.push(idx);
+                        }
+                        *slot = (d2, e as u32, t);
+                    }
+                }
+            }
+        }
+        for (k, &idx) in touched.iter().enumerate() {
+            let (_, e, t) = self.nearest[idx];
+            self.nearest[idx].0 = f64::INFINITY;
+            let index = first + k as u32;
+            self.zone[idx] = index;
+            self.edge_nodes.push(EdgeNode {
+                node: idx,
+                index,
+                a: ids[e as usize],
+                b: ids[(e as usize + 1) % m],
+                ra: e,
+                rb: ((e as usize + 1) % m) as u32,
+                t,
+            });
+        }
+    }
+
+    /// With the zone of this step laid on `fluid` (`Moving` only; nothing at rest): take out
+    /// the mass the membrane's bounce-back will put into the liquid ([`PsmFluid::set_pull_scale`])
+    /// and add to `loads` (lattice units, per body) the momentum it will take from the liquid,
+    /// less that of the liquid's mean pressure, shared between each edge's two grains in
+    /// proportion to the node's place on it.
+    pub fn membrane_reaction<T: Real>(&self, fluid: &mut PsmFluid<T>, loads: &mut [Load]) {
+        if self.boundary != MembraneBoundary::Moving {
+            return;
+        }
+        let ex: Vec<_> = self
+            .edge_nodes
+            .iter()
+            .map(|e| fluid.zone_exchange(e.node))
+            .collect();
+        let injected: f64 = ex.iter().map(|e| e.mass).sum();
+        let (mass, nodes) = fluid.liquid_mass_nodes();
+        if nodes == 0 || mass <= 0.0 {
+            return;
+        }
+        let scale = 1.0 - injected / mass;
+        fluid.set_pull_scale(scale);
+        let rho_ref = mass / nodes as f64;
+        for (e, x) in self.edge_nodes.iter().zip(&ex) {
+            let p = x.momentum(scale, rho_ref);
+            for (body, share) in [(e.a, 1.0 - e.t), (e.b, e.t)] {
+                let l = &mut loads[body as usize];
+                l.force[0] += share * p[0];
+                l.force[1] += share * p[1];
+            }
+        }
     }
 }
 

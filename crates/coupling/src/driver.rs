@@ -5,7 +5,7 @@
 //! first half-kick of velocity Verlet already uses it: the impulse the grains receive over the
 //! sub-cycles is exactly F δt, the momentum the fluid lost in the LBM step.
 
-use crate::confine::Confinement;
+use crate::confine::{Confinement, MembraneBoundary};
 use crate::error::CouplingError;
 use crate::hydro::{Hydro, HydroState};
 use crate::psm::{GrainMotion, Load};
@@ -48,6 +48,10 @@ pub struct CoupledState<T: Real> {
     /// solid map is kept between steps (`Hydro::set_remap_tolerance` above 0); else empty.
     #[serde(default)]
     pub mapped: Vec<GrainCircle>,
+    /// Where the membrane grains were at the start of the last LBM cycle (ring order), when the
+    /// membrane shows the liquid its velocity ([`MembraneBoundary::Moving`]); else empty.
+    #[serde(default)]
+    pub membrane_previous: Vec<Vec2>,
 }
 
 /// A coupled LBM-DEM run: the lattice, the grains and the scratch of both engines.
@@ -77,6 +81,8 @@ pub struct Coupled<T: Real> {
     pub timing: Timing,
     /// The liquid confined to the sample (membrane and push-plates), if set.
     confine: Option<Confinement>,
+    /// Scratch: the load a moving membrane boundary puts on each body (lattice units).
+    membrane_loads: Vec<Load>,
     /// Grain motions (lattice units) at the start of the previous LBM cycle.
     previous: Vec<GrainMotion>,
     dem: Stepper,
@@ -134,6 +140,7 @@ impl<T: Real> Coupled<T> {
             sys,
             timing: Timing::default(),
             confine: None,
+            membrane_loads: Vec::new(),
             dem: Stepper::new(),
             motions: Vec::new(),
             circles: Vec::new(),
@@ -175,9 +182,15 @@ impl<T: Real> Coupled<T> {
 
     /// Confine the liquid to the membrane minus the regions behind the walls `plates` (Su et
     /// al. 2020 Fig. 2 step 15), from now on and before every LBM step. PSM only. The nodes
-    /// outside close at once; their liquid is not counted in [`crate::ZoneMass`].
-    pub fn with_confinement(mut self, plates: Vec<usize>) -> Result<Self, CouplingError> {
-        let mut c = Confinement::new(&self.sys, plates)?;
+    /// outside close at once; their liquid is not counted in [`crate::ZoneMass`]. With
+    /// [`MembraneBoundary::Moving`] the membrane grains feel the reaction of the liquid's
+    /// bounce-back on the outline (`Confinement::membrane_reaction`), whether or not they are dry.
+    pub fn with_confinement(
+        mut self,
+        plates: Vec<usize>,
+        boundary: MembraneBoundary,
+    ) -> Result<Self, CouplingError> {
+        let mut c = Confinement::new(&self.sys, plates, boundary)?;
         let [nx, ny] = self.fluid.size();
         let (zone, vel) = c.zone(&self.sys, &self.units, nx, ny);
         self.fluid.set_zone(zone, vel)?;
@@ -250,9 +263,20 @@ impl<T: Real> Coupled<T> {
             let [nx, ny] = self.fluid.size();
             let (zone, vel) = c.zone(&self.sys, &self.units, nx, ny);
             self.fluid.set_zone(zone, vel)?;
+            self.membrane_loads.clear();
+            self.membrane_loads.resize(self.sys.bodies.len(), Load::default());
+            if let Hydro::Psm { fluid, .. } = &mut self.fluid {
+                c.membrane_reaction(fluid, &mut self.membrane_loads);
+            }
         }
         let t1 = Instant::now();
         self.fluid.step(&self.motions, &mut self.loads)?;
+        if self.confine.is_some() {
+            for (l, m) in self.loads.iter_mut().zip(&self.membrane_loads) {
+                l.force[0] += m.force[0];
+                l.force[1] += m.force[1];
+            }
+        }
         let t2 = Instant::now();
         if self.interior_liquid_correction {
             self.add_interior_liquid();
@@ -334,6 +358,11 @@ impl<T: Real> Coupled<T> {
             previous: self.previous.clone(),
             fluid: self.fluid.state(),
             mapped: self.fluid.mapped_circles(),
+            membrane_previous: self
+                .confine
+                .as_ref()
+                .map(|c| c.previous().to_vec())
+                .unwrap_or_default(),
         }
     }
 
@@ -359,6 +388,9 @@ impl<T: Real> Coupled<T> {
         self.user_force = state.user_force;
         self.user_torque = state.user_torque;
         self.previous = state.previous;
+        if let Some(c) = &mut self.confine {
+            c.set_previous(state.membrane_previous);
+        }
         self.dry.resize(n, false);
         self.dem = Stepper::new();
         Ok(())

@@ -31,8 +31,8 @@ pub mod weighting;
 pub use lbdem_core::units::coupled as units;
 
 pub use bounce::{BounceFluid, BounceState};
-pub use confine::Confinement;
+pub use confine::{Confinement, MembraneBoundary};
 pub use driver::{Coupled, CoupledState};
 pub use error::CouplingError;
 pub use hydro::{Hydro, HydroState, Method};
-pub use psm::{GrainMotion, LIQUID, Load, PsmFluid, PsmSettings, PsmState, ZoneMass};
+pub use psm::{GrainMotion, LIQUID, Load, PsmFluid, PsmSettings, PsmState, ZoneExchange, ZoneMass};

@@ -102,6 +102,8 @@ pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
     /// Liquid mass (lattice units) dropped by nodes the zone closed and added by nodes it opened,
     /// since the start.
     zone_mass: ZoneMass,
+    /// Factor on every population the next step pulls ([`PsmFluid::set_pull_scale`]); 1 after it.
+    pull_scale: f64,
     settings: PsmSettings,
     /// Uniform collision constants (f64: every update is computed in f64).
     params: CollideParams<f64>,
@@ -154,6 +156,35 @@ pub struct ZoneMass {
     /// Nodes closed and opened.
     pub closed: u64,
     pub opened: u64,
+    /// Mass taken out by [`PsmFluid::set_pull_scale`]: what a moving membrane's bounce-back put
+    /// in, so that the liquid's mass follows the sample's area as with a zone at rest.
+    #[serde(default)]
+    pub rescaled: f64,
+}
+
+/// What the bounce-back links pulling from one solid-zone node exchange with the liquid in the
+/// next step (lattice units), in parts, so that the momentum can be read for any pull scale s
+/// and reference density ρ_ref ([`ZoneExchange::momentum`]). A population f_o leaving liquid
+/// node x towards the zone comes back as f_i = s f_o + 6 w_i c_i·u_w (moving-wall bounce-back,
+/// Leonardi et al. 2014 Eq. 19 with ρ_w = 1) and hands the wall (s f_o + f_i) c_o.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ZoneExchange {
+    /// Σ 2 f_o c_o over the links.
+    pub pull: [f64; 3],
+    /// Σ 6 w_i (c_i·u_w) c_o: the wall's motion.
+    pub wall: [f64; 3],
+    /// Σ 2 w_i c_o: what a liquid at rest of unit density hands the wall (its pressure).
+    pub gauge: [f64; 3],
+    /// Σ 6 w_i c_i·u_w: the mass the links put into the liquid.
+    pub mass: f64,
+}
+
+impl ZoneExchange {
+    /// Momentum handed to the wall in the step, less that of the uniform pressure ρ_ref c_s²
+    /// (which pushes on a closed outline with no net force and only loads it internally).
+    pub fn momentum(&self, scale: f64, rho_ref: f64) -> [f64; 3] {
+        std::array::from_fn(|a| scale * self.pull[a] + self.wall[a] - rho_ref * self.gauge[a])
+    }
 }
 
 /// Equilibrium (Su Eq. 7, Leonardi Eq. 13).
@@ -247,6 +278,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             zone,
             zone_base,
             zone_mass: ZoneMass::default(),
+            pull_scale: 1.0,
             settings,
             params,
             local: None,
@@ -412,7 +444,8 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
                 velocities.len()
             )));
         }
-        self.wall_u.truncate(self.zone_base);
+        // A node that opens is refilled with the velocity of the boundary that covered it.
+        let covered_by: Vec<[f64; 3]> = self.wall_u.split_off(self.zone_base);
         self.wall_u.extend_from_slice(velocities);
         let mut changed = Vec::new();
         let mut opened = Vec::new();
@@ -445,7 +478,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
                 }
             }
             let rho = if count > 0 { sum / count as f64 } else { 1.0 };
-            let u = self.wall_u[self.zone_base + from as usize];
+            let u = covered_by[from as usize];
             let usq = norm2::<L>(u);
             for i in 0..q {
                 self.f[idx * q + i] = T::from_f64(feq::<L>(i, rho, u, usq));
@@ -499,6 +532,63 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
     /// The liquid mass the solid zone removed and added so far ([`PsmFluid::set_zone`]).
     pub fn zone_mass(&self) -> ZoneMass {
         self.zone_mass
+    }
+
+    /// Multiply every population the next step pulls by `scale` (then back to 1): takes the
+    /// mass (1 − s) M out of the liquid in proportion to each node's, leaving its velocity as
+    /// it is. Counted in [`ZoneMass::rescaled`].
+    pub fn set_pull_scale(&mut self, scale: f64) {
+        // Every population of an active node is pulled once in the step (by its neighbour, or
+        // by itself through a bounce-back link), so the step takes (1 − s) of the mass.
+        self.zone_mass.rescaled += (1.0 - scale) * self.liquid_mass_nodes().0;
+        self.pull_scale = scale;
+    }
+
+    /// Mass of the liquid (Σ ρ over the active nodes, in node order) and its node count, as the
+    /// last step (or the zone's refilling) left them.
+    pub fn liquid_mass_nodes(&self) -> (f64, usize) {
+        let (mut m, mut n) = (0.0, 0);
+        for (r, &a) in self.rho.iter().zip(&self.active) {
+            if a {
+                m += r;
+                n += 1;
+            }
+        }
+        (m, n)
+    }
+
+    /// What the links from the solid-zone node `node` to its liquid neighbours exchange in the
+    /// next step (see [`ZoneExchange`]); zero for a liquid node or one with no liquid beside it.
+    pub fn zone_exchange(&self, node: usize) -> ZoneExchange {
+        let q = L::Q;
+        let mut e = ZoneExchange::default();
+        if self.active[node] || !self.base_active[node] || self.zone[node] == LIQUID {
+            return e;
+        }
+        let w = self.zone_base as u32 + self.zone[node];
+        let uw = self.wall_u[w as usize];
+        let p = self.domain.coords(node);
+        for i in 1..q {
+            let c = L::C[i];
+            let Upstream::Node(x) = neighbour(&self.domain, p, [c[0], c[1], c[2]]) else {
+                continue;
+            };
+            if !self.active[x] || self.src[x * q + i] != WALL | w {
+                continue;
+            }
+            let o = L::OPP[i];
+            let co = L::C[o];
+            let cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1] + c[2] as f64 * uw[2];
+            let inject = 6.0 * L::W[i] * cu;
+            let fo = self.f[x * q + o].to_f64();
+            for a in 0..3 {
+                e.pull[a] += 2.0 * fo * co[a] as f64;
+                e.wall[a] += inject * co[a] as f64;
+                e.gauge[a] += 2.0 * L::W[i] * co[a] as f64;
+            }
+            e.mass += inject;
+        }
+        e
     }
 
     /// Nodes of the lattice.
@@ -579,6 +669,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             tau: self.settings.collision.tau(),
             local_tau: self.local.as_ref().map(|(_, t)| t.as_slice()),
             limits,
+            scale: self.pull_scale,
         };
 
         // Split every per-node and per-cover output into the same fixed row chunks.
@@ -634,6 +725,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
         }
         std::mem::swap(&mut self.f, &mut self.other);
         self.step += 1;
+        self.pull_scale = 1.0;
         self.cover_start = start;
 
         loads.clear();
@@ -797,6 +889,8 @@ struct Base<'a, T> {
     tau: f64,
     local_tau: Option<&'a [f64]>,
     limits: Limits,
+    /// Factor on every pulled population (`PsmFluid::set_pull_scale`).
+    scale: f64,
 }
 
 /// The nodes [node0, node0 + rho.len()) of one task and its share of the outputs.
@@ -890,7 +984,7 @@ fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
         for i in 0..q {
             let s = b.src[idx * q + i];
             f[i] = if s & WALL == 0 {
-                b.f_in[s as usize * q + i].to_f64()
+                b.scale * b.f_in[s as usize * q + i].to_f64()
             } else {
                 let uw = b.wall_u[(s & !WALL) as usize];
                 let c = L::C[i];
@@ -899,7 +993,7 @@ fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
                 if L::D == 3 {
                     cu += c[2] as f64 * uw[2];
                 }
-                b.f_in[idx * q + o].to_f64() + 6.0 * L::W[i] * cu
+                b.scale * b.f_in[idx * q + o].to_f64() + 6.0 * L::W[i] * cu
             };
         }
         // The liquid collision C(f) and the moments it used.
