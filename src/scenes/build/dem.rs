@@ -19,6 +19,19 @@ pub fn build_system(s: &Scene, base: &Path) -> Result<System> {
     if let Some(m) = membrane_spec(s) {
         assembly::install_membrane(&mut sys, &m);
     }
+    if let (Some(m), Some(mem)) = (&s.membrane, &sys.membrane) {
+        let f = m.mass_scale;
+        if !(f > 0.0 && f.is_finite()) {
+            bail!("[membrane] mass_scale = {f}: give a positive factor (1 = the grains' own masses)");
+        }
+        let b = &mut sys.bodies;
+        for &k in &mem.bodies {
+            let k = k as usize;
+            b.density[k] *= f;
+            b.mass[k] *= f;
+            b.inertia[k] *= f;
+        }
+    }
     Ok(sys)
 }
 

@@ -233,6 +233,11 @@ const RULES: &[Rule] = &[
         "outward movement before the push-back (m)",
     ),
     Rule("membrane.force", Need::NonNegative, "push-back force (N)"),
+    Rule(
+        "membrane.mass_scale",
+        Need::Positive,
+        "membrane mass scaling factor (1 = none)",
+    ),
     Rule("dem.dt", Need::Positive, "DEM time step (s)"),
     Rule("dem.skin", Need::NonNegative, "Verlet-list skin (m)"),
     Rule("dem.gravity", Need::Len(2), "gravity [gx, gy] (m/s²)"),

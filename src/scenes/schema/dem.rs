@@ -119,6 +119,13 @@ pub struct MembraneSection {
     /// paper's step, which keeps a grain resting at the threshold vibrating: `lbdem_dem::Membrane`).
     #[serde(default)]
     pub ramp: f64,
+    /// Factor on the membrane grains' masses and inertias (default 1). A membrane that shows
+    /// the liquid its velocity (`[shear_cell] membrane_boundary = "moving"`) feels the liquid's
+    /// reaction explicitly and needs grains at least 2.5 times the liquid's density
+    /// (docs/su2020.md, "The liquid confined to the sample"); the membrane is the model's
+    /// confinement, not material of the sample.
+    #[serde(default = "one")]
+    pub mass_scale: f64,
 }
 
 /// `[dem]`: the DEM time step and what acts on every grain.

@@ -18,6 +18,12 @@ pub struct ShearCellSection {
     /// zone" of Fig. 2 step 15, rebuilt every LBM step (default true).
     #[serde(default = "yes")]
     pub confine_liquid: bool,
+    /// What the liquid sees outside the membrane: `"at_rest"` (default), step 15 as written (a
+    /// sink of liquid ahead of a rising membrane: docs/su2020.md, "This is an artefact"), or
+    /// `"moving"`, a wall moving with the membrane whose reaction the membrane grains feel
+    /// (needs heavy membrane grains, and not yet stable for every assembly).
+    #[serde(default)]
+    pub membrane_boundary: lbdem_coupling::MembraneBoundary,
     /// Seconds with the plate held still before it moves (default 0): the grains come to rest
     /// against the membrane with the run's own contact law and liquid, as Su et al. relax the
     /// assembly inside the membrane before deformation (Sect. 2.4). A_0 of Eq. 18 and the
