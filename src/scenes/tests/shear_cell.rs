@@ -269,6 +269,23 @@ fn a_shear_cell_run_is_the_same_on_one_and_two_threads() {
 
 #[test]
 fn an_interrupted_shear_cell_run_resumes_to_the_same_bits() {
+    resumes_to_the_same_bits(|s| s);
+}
+
+/// The same with the membrane showing the liquid its velocity: the checkpoint carries where
+/// the membrane grains were at the last LBM step (their mean velocity over it).
+#[test]
+fn an_interrupted_run_with_a_moving_membrane_boundary_resumes_to_the_same_bits() {
+    resumes_to_the_same_bits(|s| {
+        s.replace(
+            "[shear_cell]\nplate = \"plate\"\n",
+            "[shear_cell]\nplate = \"plate\"\nmembrane_boundary = \"moving\"\n",
+        )
+        .replace("force = 1.0e-4\n", "force = 1.0e-4\nmass_scale = 3.0\n")
+    });
+}
+
+fn resumes_to_the_same_bits(edit: impl Fn(String) -> String) {
     let t = tempfile::tempdir().unwrap();
     let whole = t.path().join("whole");
     // With the solid map kept between steps (a tolerance above 0), the state a resume needs
@@ -276,7 +293,7 @@ fn an_interrupted_shear_cell_run_resumes_to_the_same_bits() {
     // (`remap::tests::at_tolerance_zero_it_gives_the_bits_of_a_fresh_map`).
     // The plate held for the first 12 steps: checkpoints fall inside the settling and after it.
     let text = cell(&whole, |s| {
-        settled("0.006")(shorter("0.03")(s))
+        edit(settled("0.006")(shorter("0.03")(s)))
             .replace("[output]\n", "[output]\ncheckpoints = { every = 5 }\n")
             .replace("r_hd = 0.8 ", "remap_tolerance = 0.02\nr_hd = 0.8 ")
     });
