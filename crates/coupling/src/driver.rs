@@ -263,15 +263,21 @@ impl<T: Real> Coupled<T> {
             let [nx, ny] = self.fluid.size();
             let (zone, vel) = c.zone(&self.sys, &self.units, nx, ny);
             self.fluid.set_zone(zone, vel)?;
-            self.membrane_loads.clear();
-            self.membrane_loads.resize(self.sys.bodies.len(), Load::default());
-            if let Hydro::Psm { fluid, .. } = &mut self.fluid {
-                c.membrane_reaction(fluid, &mut self.membrane_loads);
+            if c.boundary() == MembraneBoundary::Moving {
+                self.membrane_loads.clear();
+                self.membrane_loads.resize(self.sys.bodies.len(), Load::default());
+                if let Hydro::Psm { fluid, .. } = &mut self.fluid {
+                    c.membrane_reaction(fluid, &mut self.membrane_loads);
+                }
             }
         }
         let t1 = Instant::now();
         self.fluid.step(&self.motions, &mut self.loads)?;
-        if self.confine.is_some() {
+        if self
+            .confine
+            .as_ref()
+            .is_some_and(|c| c.boundary() == MembraneBoundary::Moving)
+        {
             for (l, m) in self.loads.iter_mut().zip(&self.membrane_loads) {
                 l.force[0] += m.force[0];
                 l.force[1] += m.force[1];

@@ -197,13 +197,7 @@ fn a_membrane_that_moves_the_liquid_raises_the_pressure_ahead_of_the_plate() {
     // lowest Δp −1.09 Pa at (1.65, 6.45) mm, by the membrane's top-left; ε_vol^DEM 0.0155; the
     // liquid's mass +1.8 % (at rest +2.3 %).
     let t = tempfile::tempdir().unwrap();
-    let moving = |s: String| {
-        s.replace(
-            "[shear_cell]\nplate = \"plate\"\n",
-            "[shear_cell]\nplate = \"plate\"\nmembrane_boundary = \"moving\"\n",
-        )
-        .replace("force = 1.0e-4\n", "force = 1.0e-4\nmass_scale = 3.0\n")
-    };
+    let moving = moving_membrane;
     let text = moving(shipped(SCENE));
     assert!(text.contains("\"moving\"") && text.contains("mass_scale = 3.0"));
     simulate(&cell(t.path(), moving), t.path(), false).unwrap();
@@ -230,18 +224,8 @@ fn a_membrane_that_moves_the_liquid_raises_the_pressure_ahead_of_the_plate() {
     // liquid's density, which blew up at LBM step 77).
     let t = tempfile::tempdir().unwrap();
     let light = |s: String| moving(s).replace("mass_scale = 3.0\n", "");
-    let e = format!(
-        "{:#}",
-        simulate(&cell(t.path(), light), t.path(), false).unwrap_err()
-    );
-    assert!(
-        e.contains("0.902 times the liquid's") && e.contains("mass_scale to at least"),
-        "{e}"
-    );
-    assert!(
-        !t.path().join("out").exists(),
-        "the refused run left output behind"
-    );
+    let got = simulate(&cell(t.path(), light), t.path(), false);
+    assert_refused(got, "0.902 times the liquid's", t.path());
 }
 
 #[test]
@@ -276,13 +260,25 @@ fn an_interrupted_shear_cell_run_resumes_to_the_same_bits() {
 /// the membrane grains were at the last LBM step (their mean velocity over it).
 #[test]
 fn an_interrupted_run_with_a_moving_membrane_boundary_resumes_to_the_same_bits() {
-    resumes_to_the_same_bits(|s| {
-        s.replace(
-            "[shear_cell]\nplate = \"plate\"\n",
-            "[shear_cell]\nplate = \"plate\"\nmembrane_boundary = \"moving\"\n",
-        )
-        .replace("force = 1.0e-4\n", "force = 1.0e-4\nmass_scale = 3.0\n")
-    });
+    resumes_to_the_same_bits(moving_membrane);
+}
+
+/// The reduced cell with the membrane showing the liquid its velocity, its grains 2.7 times the
+/// liquid's density.
+fn moving_membrane(s: String) -> String {
+    s.replace(
+        "[shear_cell]\nplate = \"plate\"\n",
+        "[shear_cell]\nplate = \"plate\"\nmembrane_boundary = \"moving\"\n",
+    )
+    .replace("force = 1.0e-4\n", "force = 1.0e-4\nmass_scale = 3.0\n")
+}
+
+/// A run refused before it starts: the message names `needle` and the fix, and nothing is left
+/// in `dir`.
+fn assert_refused(got: anyhow::Result<StageRecord>, needle: &str, dir: &Path) {
+    let e = format!("{:#}", got.unwrap_err());
+    assert!(e.contains(needle) && e.contains("mass_scale to at least"), "{e}");
+    assert!(!dir.join("out").exists(), "the refused run left output behind");
 }
 
 fn resumes_to_the_same_bits(edit: impl Fn(String) -> String) {
@@ -702,15 +698,7 @@ fn grains_lighter_than_half_the_liquid_are_refused_as_the_density_map_found() {
         assert!(text.contains(&format!("mass_scale = {scale}")));
         let got = simulate(&text, t.path(), false);
         if refused {
-            let e = format!("{:#}", got.unwrap_err());
-            assert!(
-                e.contains("0.451 times the liquid's") && e.contains("mass_scale to at least"),
-                "{e}"
-            );
-            assert!(
-                !t.path().join("out").exists(),
-                "the refused run left output behind"
-            );
+            assert_refused(got, "0.451 times the liquid's", t.path());
         } else {
             got.unwrap();
         }
