@@ -5,8 +5,9 @@
 //! - `contacts_<step>.csv`: one row per touching pair of circles: `i`, `j`, `body_i`,
 //!   `body_j` and the contact force on i, `fx`, `fy` (j receives the opposite);
 //! - `fluid_<step>.csv`: one row per node: `i`, `j`, `k`, the node's `x`, `y`, `z`, velocity
-//!   `ux`, `uy`, `uz` (m/s), `pressure` (Pa, relative to the reference density) and, coupled,
-//!   the `solid_fraction`; NaN on nodes that hold no liquid.
+//!   `ux`, `uy`, `uz` (m/s), `pressure` (Pa, relative to the reference density; coupled, Su
+//!   Eq. 19's Δp on the liquid nodes only, cells less than half solid) and, coupled, the
+//!   `solid_fraction`; NaN on nodes that hold no liquid.
 //!
 //! Every number reads back to the same bits (`crate::report::table`). [`read_particles`],
 //! [`read_contacts`] and [`read_fluid`] read them, e.g. for the analysis of a run.
@@ -209,7 +210,8 @@ pub struct FluidFields {
     pub dx: f64,
     /// Interleaved xyz, m/s; NaN where no liquid.
     pub velocity: Vec<f64>,
-    /// Pa relative to the reference density; NaN where no liquid.
+    /// Pa relative to the reference density; NaN where no liquid (coupled: on nodes at least
+    /// half solid too).
     pub pressure: Vec<f64>,
     /// Coupled scenes: the solid fraction of every node (Su Eqs. 9-10).
     pub solid_fraction: Option<Vec<f64>>,

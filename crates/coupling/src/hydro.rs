@@ -8,7 +8,6 @@ use crate::psm::{GrainMotion, Load, PsmFluid, PsmState, ZoneMass};
 use crate::remap::SolidMapper;
 use crate::solid_fraction::{GrainCircle, SolidMap};
 use lbdem_lbm::Real;
-use lbdem_lbm::lattice::CS2;
 use serde::{Deserialize, Serialize};
 
 /// Which fluid-solid coupling a run uses.
@@ -254,11 +253,5 @@ impl<T: Real> Hydro<T> {
                 }
             }
         }
-    }
-
-    /// Pressure change Δp = (ρ − 1) c_s² of every node, lattice units (Su Eq. 19); NaN off the fluid.
-    pub fn pressure_change(&self) -> Vec<f64> {
-        let [nx, ny] = self.size();
-        (0..nx * ny).map(|i| (self.node(i).0 - 1.0) * CS2).collect()
     }
 }

@@ -270,15 +270,17 @@ impl Tracked {
     }
 
     /// After each step of the model: at the end of the settling, set the plate moving and take
-    /// A_0 and the plate's origin from the settled sample.
-    pub fn after_step(&mut self, sys: &mut System, steps: u64) {
+    /// A_0 and the plate's origin from the settled sample. True at that step.
+    pub fn after_step(&mut self, sys: &mut System, steps: u64) -> bool {
         if let Some(h) = self.hold
             && steps == h.until
         {
             sys.walls[self.cell.plate].vel = h.velocity;
             self.start = self.cell.plate_anchor(sys);
             self.a0 = self.cell.area(sys);
+            return true;
         }
+        false
     }
     pub fn origin(&self) -> Origin {
         Origin {
