@@ -52,6 +52,10 @@ pub struct CoupledState<T: Real> {
     /// membrane shows the liquid its velocity ([`MembraneBoundary::Moving`]); else empty.
     #[serde(default)]
     pub membrane_previous: Vec<Vec2>,
+    /// The velocities the membrane grains showed the liquid in the last LBM cycle (ring order;
+    /// `Moving` only), which an under-relaxed boundary carries on from.
+    #[serde(default)]
+    pub membrane_shown: Vec<Vec2>,
 }
 
 /// A coupled LBM-DEM run: the lattice, the grains and the scratch of both engines.
@@ -198,6 +202,16 @@ impl<T: Real> Coupled<T> {
             fluid.reset_zone_mass();
         }
         self.confine = Some(c);
+        Ok(self)
+    }
+
+    /// Under-relax the velocity the moving membrane shows the liquid
+    /// ([`Confinement::set_relaxation`]); after [`Coupled::with_confinement`].
+    pub fn with_membrane_relaxation(mut self, omega: f64) -> Result<Self, CouplingError> {
+        let c = self.confine.as_mut().ok_or_else(|| {
+            CouplingError::Unsupported("membrane relaxation without a confined liquid".into())
+        })?;
+        c.set_relaxation(omega)?;
         Ok(self)
     }
 
@@ -369,6 +383,11 @@ impl<T: Real> Coupled<T> {
                 .as_ref()
                 .map(|c| c.previous().to_vec())
                 .unwrap_or_default(),
+            membrane_shown: self
+                .confine
+                .as_ref()
+                .map(|c| c.shown().to_vec())
+                .unwrap_or_default(),
         }
     }
 
@@ -396,6 +415,7 @@ impl<T: Real> Coupled<T> {
         self.previous = state.previous;
         if let Some(c) = &mut self.confine {
             c.set_previous(state.membrane_previous);
+            c.set_shown(state.membrane_shown);
         }
         self.dry.resize(n, false);
         self.dem = Stepper::new();

@@ -269,6 +269,11 @@ const RULES: &[Rule] = &[
         "shear length (m; Su: 0.01)",
     ),
     Rule(
+        "shear_cell.membrane_relaxation",
+        Need::OpenFraction,
+        "weight of the membrane's newest velocity (default 0.5; 1 = none kept)",
+    ),
+    Rule(
         "shear_cell.settle",
         Need::NonNegative,
         "time with the plate held before it moves (s; 0 = none)",
