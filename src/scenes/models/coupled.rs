@@ -63,6 +63,14 @@ pub struct CoupledModel<T: Real> {
 /// wholly inside membrane grains (docs/su2020.md, "The cracking criterion on liquid nodes").
 pub const LIQUID_NODE_SOLID_MAX: f64 = 0.5;
 
+/// Mean of the finite values, in order (None without any).
+fn finite_mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values
+        .filter(|v| v.is_finite())
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
 /// Series columns of the liquid's mass (kg): what the lattice holds, its drift from the start
 /// (relative), and what the moving solid zone closed and opened.
 const MASS_COLUMNS: [&str; 4] = [
@@ -260,10 +268,7 @@ impl<T: Real> CoupledModel<T> {
     /// The liquid nodes' mean density (lattice units), 1 without any.
     fn mean_liquid_density(&self) -> f64 {
         let [nx, ny] = self.run.fluid.size();
-        let (sum, n) = (0..nx * ny)
-            .filter_map(|i| self.liquid_density(i))
-            .fold((0.0, 0usize), |(s, n), r| (s + r, n + 1));
-        if n == 0 { 1.0 } else { sum / n as f64 }
+        finite_mean((0..nx * ny).filter_map(|i| self.liquid_density(i))).unwrap_or(1.0)
     }
 
     /// Position (m) of the liquid node with the lowest Δp (the first of equals), NaN without liquid.
@@ -382,11 +387,7 @@ impl<T: Real> Model for CoupledModel<T> {
         let dp = self.pressure_change();
         let (lo, hi) = crate::report::plot::finite_range(dp.iter().copied()).unwrap_or((0.0, 0.0));
         let below = dp.iter().filter(|&&p| p < self.threshold).count() as f64 * u.dx() * u.dx();
-        let (sum, n) = dp
-            .iter()
-            .filter(|p| p.is_finite())
-            .fold((0.0, 0usize), |(s, n), p| (s + p, n + 1));
-        let mean_dp = if n == 0 { f64::NAN } else { sum / n as f64 };
+        let mean_dp = finite_mean(dp.iter().copied()).unwrap_or(f64::NAN);
         let hydro = run
             .hydro
             .iter()
