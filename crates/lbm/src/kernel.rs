@@ -11,6 +11,7 @@ use crate::lattice::{Lattice, QMAX};
 use crate::plan::{Plan, Upstream, neighbour};
 use crate::real::Real;
 use crate::zouhe;
+use lbdem_core::simd::{NATIVE_V4, Simd};
 
 /// Block width of the fast path for values of `T`: two AVX-512 registers per quantity, 32 f32 or
 /// 16 f64 nodes. One register per quantity (16 f32, 8 f64) or four (32 f64) ran 15-40 % slower in
@@ -20,6 +21,44 @@ use crate::zouhe;
 pub const fn wide<T>() -> usize {
     if std::mem::size_of::<T>() == 4 { 32 } else { 16 }
 }
+
+/// Block width of the fast path in the copy compiled for instruction-set level `S`
+/// (`lbdem_core::simd::dispatch`): [`wide`] where the copy has 256-bit vectors or wider (AVX2,
+/// AVX-512, or any copy of a build for an AVX-512 CPU), two SSE registers per quantity (8 f32,
+/// 4 f64) in the portable copy. A block's width sets how many nodes share an instruction, never
+/// what a lane computes, so every copy still gives the same bits. At the wide blocks the portable
+/// copies were half this crate's machine code (7.3 of 15 MB, mostly spills of 32-node blocks
+/// into 16 SSE registers) and the largest part of its build time, for a path only CPUs without
+/// AVX2 take.
+#[inline(always)]
+pub const fn block_width<T, S: Simd>() -> usize {
+    if NATIVE_V4 || std::mem::size_of::<S::f32s>() >= 32 {
+        wide::<T>()
+    } else {
+        32 / std::mem::size_of::<T>()
+    }
+}
+
+/// Call `$run::<.., WB>` with `WB` = [`block_width`]`::<T, S>()`: the branch is resolved
+/// before LLVM (`const { }`), so each copy holds the kernel at its own width only.
+macro_rules! at_block_width {
+    ($t:ty, $s:ty, $wb:ident => $call:expr) => {
+        if const { $crate::kernel::block_width::<$t, $s>() == 32 } {
+            const $wb: usize = 32;
+            $call
+        } else if const { $crate::kernel::block_width::<$t, $s>() == 16 } {
+            const $wb: usize = 16;
+            $call
+        } else if const { $crate::kernel::block_width::<$t, $s>() == 8 } {
+            const $wb: usize = 8;
+            $call
+        } else {
+            const $wb: usize = 4;
+            $call
+        }
+    };
+}
+pub(crate) use at_block_width;
 
 /// Raw pointer that may cross threads; every use writes only rows that one task owns.
 #[derive(Clone, Copy)]
@@ -131,7 +170,10 @@ pub struct Ctx<'a, T, C> {
 /// `ctx.dst` (and `ctx.out`) must point to arrays of the right length, and no other thread may
 /// write row `r` during the call.
 #[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
-pub unsafe fn row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(ctx: &Ctx<T, C>, r: usize) -> bool {
+pub unsafe fn row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
+    ctx: &Ctx<T, C>,
+    r: usize,
+) -> bool {
     let dom = ctx.dom;
     let [nx, ny, _] = dom.n;
     let n = dom.len();
@@ -156,11 +198,7 @@ pub unsafe fn row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(ctx: &C
     }
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
         good &= unsafe {
-            if wide::<T>() == 32 {
-                span::<L, T, C, F, 32>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
-            } else {
-                span::<L, T, C, F, 16>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off)
-            }
+            at_block_width!(T, S, WB => span::<L, T, C, F, WB>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off))
         };
     }
     // periodic x edges with only fluid neighbours: the fast path with a wrapped x
@@ -184,7 +222,7 @@ pub unsafe fn row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(ctx: &C
 }
 
 /// Nodes [x0, x1) of a fast span in blocks of `WB`, the rest in one block each of 16, 8, 4, 2, 1
-/// nodes at most (as `kernel_aa::run`).
+/// nodes at most (those narrower than `WB`; as `kernel_aa::run`).
 ///
 /// # Safety
 /// As `block`.
@@ -207,7 +245,8 @@ unsafe fn span<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB: 
     }
     macro_rules! tail {
         ($b:literal) => {
-            if $b < WB && $b <= x1 - x {
+            // not compiled at all where the block is narrower (`const { }`)
+            if const { $b < WB } && $b <= x1 - x {
                 let mut g = [[T::default(); $b]; QMAX];
                 good &= unsafe { block::<L, T, C, $b, F>(ctx, &mut g, src, dst, x, row_off + x) };
                 x += $b;

@@ -14,11 +14,12 @@
 
 use crate::collision::{Collider, Moments};
 use crate::domain::{Domain, FLUID, Motion};
-use crate::kernel::{LimitsT, MacroOut, SyncPtr, wide, wrap};
+use crate::kernel::{LimitsT, MacroOut, SyncPtr, at_block_width, wrap};
 use crate::lattice::{Lattice, QMAX};
 use crate::layout::Layout;
 use crate::plan::{Plan, Upstream, neighbour};
 use crate::real::Real;
+use lbdem_core::simd::Simd;
 
 /// First node of a row that left the limits: (x, ρ, u).
 pub type Bad = Option<(usize, f64, [f64; 3])>;
@@ -88,7 +89,7 @@ fn first_bad<T: Real, C, const B: usize>(
 /// # Safety
 /// `ctx.f` must hold Q `ctx.layout.stride` values; no other thread may touch the nodes of row `r`.
 #[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
-pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
     ctx: &CtxAa<T, C>,
     r: usize,
 ) -> Bad {
@@ -108,7 +109,7 @@ pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
         dst[i] = L::OPP[i] * n + slot_off;
     }
     for &(x0, x1) in &plan.runs[plan.run_start[r] as usize..plan.run_start[r + 1] as usize] {
-        unsafe { run::<L, T, C, F>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
+        unsafe { run::<L, T, C, F, S>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     bad
 }
@@ -137,14 +138,14 @@ unsafe fn block<L: Lattice, T: Real, C: Collider<L, T>, const B: usize, const F:
     check::<T, C, B>(ctx, &m, node, bad);
 }
 
-/// Nodes [x0, x1) of a row in blocks of `kernel::wide::<T>()` nodes (two AVX-512 registers per
-/// quantity), the rest in one block each of 16, 8, 4, 2 and 1 nodes at most (narrower vectors
-/// instead of up to 31 scalar nodes).
+/// Nodes [x0, x1) of a row in blocks of `kernel::block_width::<T, S>()` nodes (two AVX-512
+/// registers per quantity where the copy has 256-bit vectors or wider), the rest in one block each
+/// of 16, 8, 4, 2 and 1 nodes at most (narrower vectors instead of up to 31 scalar nodes).
 ///
 /// # Safety
 /// As `block`.
 #[inline(always)]
-unsafe fn run<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+unsafe fn run<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
     ctx: &CtxAa<T, C>,
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
@@ -153,11 +154,7 @@ unsafe fn run<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
     node_off: usize,
     bad: &mut Bad,
 ) {
-    if wide::<T>() == 32 {
-        unsafe { run_w::<L, T, C, F, 32>(ctx, src, dst, x0, x1, node_off, bad) }
-    } else {
-        unsafe { run_w::<L, T, C, F, 16>(ctx, src, dst, x0, x1, node_off, bad) }
-    }
+    unsafe { at_block_width!(T, S, WB => run_w::<L, T, C, F, WB>(ctx, src, dst, x0, x1, node_off, bad)) }
 }
 
 #[inline(always)]
@@ -179,7 +176,8 @@ unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB:
     }
     macro_rules! tail {
         ($b:literal) => {
-            if $b < WB && $b <= x1 - x {
+            // not compiled at all where the block is narrower (`const { }`)
+            if const { $b < WB } && $b <= x1 - x {
                 let mut g = [[T::default(); $b]; QMAX];
                 unsafe { block::<L, T, C, $b, F>(ctx, &mut g, src, dst, x, node_off + x, bad) };
                 x += $b;
@@ -200,7 +198,7 @@ unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB:
 /// As `even_row`; the slots a node touches are its own (see the module doc), so rows may run
 /// concurrently.
 #[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
-pub unsafe fn odd_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
+pub unsafe fn odd_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
     ctx: &CtxAa<T, C>,
     r: usize,
 ) -> Bad {
@@ -227,7 +225,7 @@ pub unsafe fn odd_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
     }
     let plan = ctx.plan;
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
-        unsafe { run::<L, T, C, F>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
+        unsafe { run::<L, T, C, F, S>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     for &x in &plan.wraps[plan.wrap_start[r] as usize..plan.wrap_start[r + 1] as usize] {
         let x = x as usize;

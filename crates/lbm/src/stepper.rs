@@ -165,7 +165,7 @@ impl<L: Lattice, T: Real, C: Collider<L, T>, const F: bool> WithSimd for Rows<'_
     fn with_simd<S: Simd>(self, _: S) {
         for (k, g) in self.flags.iter_mut().enumerate() {
             // SAFETY: each row index belongs to exactly one chunk.
-            *g = unsafe { kernel::row::<L, T, C, F>(self.ctx, self.first + k) };
+            *g = unsafe { kernel::row::<L, T, C, F, S>(self.ctx, self.first + k) };
         }
     }
 }

@@ -119,9 +119,9 @@ impl<L: Lattice, T: Real, C: crate::collision::Collider<L, T>, const ODD: bool, 
             // SAFETY: every node touches only its own slots (kernel_aa module doc).
             *b = unsafe {
                 if ODD {
-                    kernel_aa::odd_row::<L, T, C, F>(self.ctx, r)
+                    kernel_aa::odd_row::<L, T, C, F, S>(self.ctx, r)
                 } else {
-                    kernel_aa::even_row::<L, T, C, F>(self.ctx, r)
+                    kernel_aa::even_row::<L, T, C, F, S>(self.ctx, r)
                 }
             };
         }
