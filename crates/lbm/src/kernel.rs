@@ -39,8 +39,9 @@ pub const fn block_width<T, S: Simd>() -> usize {
     }
 }
 
-/// Call `$run::<.., WB>` with `WB` = [`block_width`]`::<T, S>()`: the branch is resolved
-/// before LLVM (`const { }`), so each copy holds the kernel at its own width only.
+/// Evaluate `$call` with the constant `$wb` = [`block_width`]`::<T, S>()` in scope (it names the
+/// kernel's block width, e.g. `run_w::<L, T, C, F, WB>`). The branches are resolved before LLVM
+/// (`const { }`), so each copy holds the kernel at its own width only.
 macro_rules! at_block_width {
     ($t:ty, $s:ty, $wb:ident => $call:expr) => {
         if const { $crate::kernel::block_width::<$t, $s>() == 32 } {
