@@ -23,19 +23,25 @@ pub const fn wide<T>() -> usize {
 }
 
 /// Block width of the fast path in the copy compiled for instruction-set level `S`
-/// (`lbdem_core::simd::dispatch`): [`wide`] where the copy has 256-bit vectors or wider (AVX2,
-/// AVX-512, or any copy of a build for an AVX-512 CPU), two SSE registers per quantity (8 f32,
-/// 4 f64) in the portable copy. A block's width sets how many nodes share an instruction, never
+/// (`lbdem_core::simd::dispatch`): [`wide`] in the AVX-512 copy (or any copy of a build for an
+/// AVX-512 CPU) and for f64 in the AVX2 copy; two registers per quantity otherwise, 16 f32 in the
+/// AVX2 copy and 8 f32 or 4 f64 in the portable one (docs/performance.md, "The portable copy's LBM
+/// blocks are narrower", has the paired benchmark behind the AVX2 choices). A block's width sets how many nodes share an instruction, never
 /// what a lane computes, so every copy still gives the same bits. At the wide blocks the portable
 /// copies were half this crate's machine code (7.3 of 15 MB, mostly spills of 32-node blocks
 /// into 16 SSE registers) and the largest part of its build time, for a path only CPUs without
 /// AVX2 take.
 #[inline(always)]
 pub const fn block_width<T, S: Simd>() -> usize {
-    if NATIVE_V4 || std::mem::size_of::<S::f32s>() >= 32 {
+    let reg = std::mem::size_of::<S::f32s>();
+    if NATIVE_V4 || reg >= 64 {
+        wide::<T>()
+    } else if reg >= 32 && std::mem::size_of::<T>() == 8 {
+        // AVX2 f64: four registers per quantity, as with AVX-512; two ran at half the rate
         wide::<T>()
     } else {
-        32 / std::mem::size_of::<T>()
+        // two registers per quantity: AVX2 f32 (16 nodes, 11-21 % faster than 32) and SSE
+        2 * if reg < 16 { 16 } else { reg } / std::mem::size_of::<T>()
     }
 }
 
