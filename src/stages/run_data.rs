@@ -33,6 +33,24 @@ pub fn manifest_input(spec: &str, ctx: &StageContext) -> Option<PathBuf> {
     (ctx.earlier_stage(spec.trim_start_matches('@')).is_some() || m.is_file()).then_some(m)
 }
 
+/// The scene file a run recorded. `simulate` records it as given, relative to where it ran; when
+/// that path does not lead to it from here, the same relative path under each directory that
+/// holds the run (nearest first) is tried, and the first file with the bytes the run recorded
+/// (its SHA-256) is the scene. Otherwise the recorded path, whose error says to give `scene`.
+fn recorded_scene(dir: &Path, recorded: &crate::contract::InputHash) -> PathBuf {
+    let path = &recorded.path;
+    if path.is_absolute() || path.is_file() {
+        return path.clone();
+    }
+    let Ok(dir) = dir.canonicalize() else {
+        return path.clone();
+    };
+    dir.ancestors()
+        .map(|a| a.join(path))
+        .find(|p| p.is_file() && crate::pipeline::hash_file(p).is_ok_and(|h| h.sha256 == recorded.sha256))
+        .unwrap_or_else(|| path.clone())
+}
+
 /// One row of `snapshots.csv`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SnapshotEntry {
@@ -304,13 +322,15 @@ impl Run {
                 rec.kind
             );
         }
-        let scene_path =
-            match scene {
-                Some(p) => p.to_path_buf(),
-                None => rec.inputs.first().map(|i| i.path.clone()).with_context(|| {
+        let scene_path = match scene {
+            Some(p) => p.to_path_buf(),
+            None => recorded_scene(
+                dir,
+                rec.inputs.first().with_context(|| {
                     format!("{} lists no scene file among its inputs", manifest.display())
                 })?,
-            };
+            ),
+        };
         let overrides: toml::Table = match rec.params.get("overrides") {
             Some(v) if !v.is_null() => serde_json::from_value(v.clone())
                 .with_context(|| format!("{}: params.overrides is not a table", manifest.display()))?,
@@ -551,6 +571,30 @@ mod tests {
         // Two unit circles one radius apart: 2π - lens, lens = 2π/3 - √3/2.
         let lens = 2.0 * pi / 3.0 - 3f64.sqrt() / 2.0;
         assert!((union2([0.0, 0.0, 1.0], [1.0, 0.0, 1.0]) - (2.0 * pi - lens)).abs() < 1e-12);
+    }
+
+    /// A run simulated in another directory records its scene relative to that directory; the
+    /// scene is found under the directories holding the run, and only with the recorded bytes.
+    #[test]
+    fn a_run_finds_its_scene_from_another_directory_by_its_bytes() {
+        let t = tempfile::tempdir().unwrap();
+        let rel = Path::new("scenes-not-in-the-repo/cell.toml");
+        let scene = t.path().join(rel);
+        std::fs::create_dir_all(scene.parent().unwrap()).unwrap();
+        std::fs::write(&scene, "[scene]\nname = \"cell\"\n").unwrap();
+        let run = t.path().join("runs/cell");
+        std::fs::create_dir_all(&run).unwrap();
+        let mut recorded = crate::pipeline::hash_file(&scene).unwrap();
+        recorded.path = rel.to_path_buf();
+        assert!(
+            !rel.is_file(),
+            "the test needs a path that does not exist from the working directory"
+        );
+        assert_eq!(recorded_scene(&run, &recorded), scene.canonicalize().unwrap());
+        // The same path with other bytes is another scene: the recorded path comes back, and
+        // opening it fails with the message that says to give `scene`.
+        std::fs::write(&scene, "[scene]\nname = \"changed\"\n").unwrap();
+        assert_eq!(recorded_scene(&run, &recorded), rel);
     }
 
     #[test]
