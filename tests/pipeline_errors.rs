@@ -73,3 +73,20 @@ fn a_benchmark_of_zero_repetitions_is_refused() {
     assert!(!ok, "{err}");
     assert!(err.contains("--reps") && err.contains("at least 1"), "{err}");
 }
+
+/// A refusal prints its message and causes, not a stack backtrace, even under RUST_BACKTRACE=1.
+#[test]
+fn a_refusal_prints_no_backtrace_under_rust_backtrace() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.toml");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_lbdem"))
+        .args(["run", missing.to_str().unwrap()])
+        .env("RUST_BACKTRACE", "1")
+        .env_remove("RUST_LIB_BACKTRACE")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("missing.toml"), "{err}");
+    assert!(!err.contains("backtrace"), "{err}");
+}
