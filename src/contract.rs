@@ -12,9 +12,11 @@
 //! figures and tables for the report, every file it wrote, and a JSON summary. The runner
 //! wraps that in a [`StageRecord`] (the `stage.json` manifest) and a [`Provenance`] block.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
+use sha2::Digest;
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// The file name of a stage's manifest, in its output directory.
@@ -199,6 +201,31 @@ pub struct InputHash {
     pub path: PathBuf,
     pub sha256: String,
     pub bytes: u64,
+}
+
+/// SHA-256 of a file (streamed): what the runner records of each input, and what a stage
+/// compares with a record (a run's scene found again elsewhere).
+pub fn hash_file(path: &Path) -> Result<InputHash> {
+    let mut f = std::fs::File::open(path)
+        .with_context(|| format!("input file {} cannot be opened", path.display()))?;
+    let mut h = sha2::Sha256::new();
+    let mut buf = vec![0u8; 1 << 20];
+    let mut bytes = 0u64;
+    loop {
+        let n = f
+            .read(&mut buf)
+            .with_context(|| format!("reading {}", path.display()))?;
+        if n == 0 {
+            break;
+        }
+        bytes += n as u64;
+        h.update(&buf[..n]);
+    }
+    Ok(InputHash {
+        path: path.to_path_buf(),
+        sha256: hex::encode(h.finalize()),
+        bytes,
+    })
 }
 
 /// What the runner stores for one executed (or cache-hit) stage in `stage.json`.

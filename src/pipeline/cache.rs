@@ -1,36 +1,11 @@
 //! Content-hash cache: a stage is skipped when its kind, parameters, input bytes and the
 //! code version hash to the key stored in its manifest and every output it listed exists.
 
+pub use crate::contract::hash_file;
 use crate::contract::{InputHash, MANIFEST, StageContext, StageRecord};
 use crate::registry::Prepared;
 use anyhow::{Context, Result};
-use sha2::{Digest, Sha256};
-use std::io::Read;
-use std::path::{Path, PathBuf};
-
-/// SHA-256 of a file (streamed).
-pub fn hash_file(path: &Path) -> Result<InputHash> {
-    let mut f = std::fs::File::open(path)
-        .with_context(|| format!("input file {} cannot be opened", path.display()))?;
-    let mut h = Sha256::new();
-    let mut buf = vec![0u8; 1 << 20];
-    let mut bytes = 0u64;
-    loop {
-        let n = f
-            .read(&mut buf)
-            .with_context(|| format!("reading {}", path.display()))?;
-        if n == 0 {
-            break;
-        }
-        bytes += n as u64;
-        h.update(&buf[..n]);
-    }
-    Ok(InputHash {
-        path: path.to_path_buf(),
-        sha256: hex::encode(h.finalize()),
-        bytes,
-    })
-}
+use std::path::PathBuf;
 
 /// Hash every input; a directory counts as all files in it (sorted, not recursive).
 pub fn hash_inputs(paths: &[PathBuf]) -> Result<Vec<InputHash>> {

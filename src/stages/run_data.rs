@@ -47,7 +47,7 @@ fn recorded_scene(dir: &Path, recorded: &crate::contract::InputHash) -> PathBuf 
     };
     dir.ancestors()
         .map(|a| a.join(path))
-        .find(|p| p.is_file() && crate::pipeline::hash_file(p).is_ok_and(|h| h.sha256 == recorded.sha256))
+        .find(|p| p.is_file() && crate::contract::hash_file(p).is_ok_and(|h| h.sha256 == recorded.sha256))
         .unwrap_or_else(|| path.clone())
 }
 
@@ -584,7 +584,7 @@ mod tests {
         std::fs::write(&scene, "[scene]\nname = \"cell\"\n").unwrap();
         let run = t.path().join("runs/cell");
         std::fs::create_dir_all(&run).unwrap();
-        let mut recorded = crate::pipeline::hash_file(&scene).unwrap();
+        let mut recorded = crate::contract::hash_file(&scene).unwrap();
         recorded.path = rel.to_path_buf();
         assert!(
             !rel.is_file(),
