@@ -15,7 +15,7 @@
 use anyhow::{Context, Result};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
-use sha2::Digest;
+use sha2::{Digest, Sha256};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -208,7 +208,7 @@ pub struct InputHash {
 pub fn hash_file(path: &Path) -> Result<InputHash> {
     let mut f = std::fs::File::open(path)
         .with_context(|| format!("input file {} cannot be opened", path.display()))?;
-    let mut h = sha2::Sha256::new();
+    let mut h = Sha256::new();
     let mut buf = vec![0u8; 1 << 20];
     let mut bytes = 0u64;
     loop {

@@ -47,7 +47,7 @@ fn recorded_scene(dir: &Path, recorded: &crate::contract::InputHash) -> PathBuf 
     };
     dir.ancestors()
         .map(|a| a.join(path))
-        .find(|p| p.is_file() && crate::contract::hash_file(p).is_ok_and(|h| h.sha256 == recorded.sha256))
+        .find(|p| crate::contract::hash_file(p).is_ok_and(|h| h.sha256 == recorded.sha256))
         .unwrap_or_else(|| path.clone())
 }
 
