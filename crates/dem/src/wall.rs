@@ -105,6 +105,26 @@ impl Wall {
         }
     }
 
+    /// False where [`Wall::touch_within`] with reach `reach` (r + range) surely gives `None`: a
+    /// plane's circles farther than the reach, a segment's outside its bounding box grown by the
+    /// reach (each with a hair more than the round-off of the distance). The wall pass's search
+    /// for the circles near a wall (`stepper/walls.rs`).
+    #[inline]
+    pub fn may_touch(&self, c: Vec2, reach: f64) -> bool {
+        match self.shape {
+            WallShape::Plane { p, n } => {
+                (c - p).dot(n) < reach + 1e-6 * reach.abs() + 1e-12 * (p.x.abs() + p.y.abs())
+            }
+            WallShape::Segment { a, b } => {
+                let g = reach + 1e-6 * reach.abs() + 1e-12 * (a.x.abs() + a.y.abs() + b.x.abs() + b.y.abs());
+                c.x >= a.x.min(b.x) - g
+                    && c.x <= a.x.max(b.x) + g
+                    && c.y >= a.y.min(b.y) - g
+                    && c.y <= a.y.max(b.y) + g
+            }
+        }
+    }
+
     /// Normal stress on a servo wall (N/m), compressive positive.
     pub fn stress(&self, length: f64) -> f64 {
         match self.shape {

@@ -223,3 +223,66 @@ fn a_circle_beyond_the_domain_is_refused() {
     let err = bad.check_state().unwrap_err();
     assert!(err.contains("circle 3") && err.contains("diagonal"), "{err}");
 }
+
+/// The wall pass evaluates only the circles its search found near a wall (within the reach plus
+/// the skin, searched again when the pair list is rebuilt or a wall moved half the skin). A
+/// push-plate (segment) moving into a row of two-circle clumps at rest, no gravity: nothing else
+/// moves, so the pair list is not rebuilt, and only the plate's own motion can start the search
+/// that finds the clumps it reaches. The same bits with a skin of 0.05 (the plate moves 1.2, 48
+/// half-skins) as with a skin of 100 (every circle near the plate at every step).
+#[test]
+fn walls_give_the_same_bits_at_any_skin() {
+    use lbdem_dem::wall::{Wall, WallMotion, WallShape};
+    let grain = ClumpShape {
+        balls: vec![
+            Ball {
+                centre: Vec2::new(-0.2, 0.0),
+                r: 0.4,
+            },
+            Ball {
+                centre: Vec2::new(0.25, 0.0),
+                r: 0.3,
+            },
+        ],
+    };
+    let mut bodies = Bodies::new();
+    for k in 0..6 {
+        bodies
+            .add(&grain, 1.0, Vec2::new(1.0 + 1.5 * k as f64, 1.0), 0.3 * k as f64)
+            .unwrap();
+    }
+    let mut s0 = System::new(bodies, Domain::open(Vec2::new(-5.0, -5.0), Vec2::new(15.0, 15.0)));
+    s0.walls.push(Wall::new(
+        WallShape::Segment {
+            a: Vec2::new(0.0, 0.0),
+            b: Vec2::new(10.0, 0.0),
+        },
+        WallMotion::Velocity {
+            v: Vec2::new(0.0, 2.0),
+        },
+    ));
+    let law = LinearSpringDashpot::new(2e4, 2e4 * 2.0 / 7.0, Damping::Gamma(50.0), 0.5);
+    let go = |skin: f64| {
+        let p = StepParams::new(2.0e-4, skin);
+        let (mut s, mut st) = (s0.clone(), Stepper::new());
+        let mut plate_contacts = 0;
+        for _ in 0..3000 {
+            st.step(&p, &law, &law, &mut s).unwrap();
+            plate_contacts = plate_contacts.max(s.walls[0].n_contacts);
+        }
+        (s, plate_contacts)
+    };
+    let ((a, na), (b, nb)) = (go(0.05), go(100.0));
+    // 3 at once at most (the grains are knocked off as it reaches them); 0 if the plate's motion
+    // did not start the search (checked by disabling it).
+    assert!(na >= 2, "the plate must push the grains: {na} at most in contact");
+    assert_eq!(na, nb);
+    assert_eq!(bits(&a), bits(&b));
+    let wall_bits = |s: &System| {
+        s.walls
+            .iter()
+            .flat_map(|w| [w.force.x, w.force.y].map(f64::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(wall_bits(&a), wall_bits(&b));
+}

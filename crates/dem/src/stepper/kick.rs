@@ -66,7 +66,7 @@ impl Stepper {
             .zip(b.angle.par_iter_mut().zip(b.omega.par_iter_mut()))
             .zip(self.kick.par_iter_mut())
             .enumerate()
-            .with_min_len(4096)
+            .with_min_len(1024)
             .for_each(|(k, (((x, v), (a, w)), kk))| {
                 kk.refresh(h, mass[k], inertia[k]);
                 *v += force[k] * kk.hm;
@@ -91,7 +91,7 @@ impl Stepper {
         b.angle
             .par_iter()
             .zip(self.turn.par_iter_mut())
-            .with_min_len(4096)
+            .with_min_len(1024)
             .for_each(|(a, t)| *t = a.sin_cos());
         let turn = &self.turn;
         self.cpos
@@ -99,7 +99,7 @@ impl Stepper {
             .zip(self.carm.par_iter_mut())
             .zip(self.cstate.par_iter_mut())
             .enumerate()
-            .with_min_len(4096)
+            .with_min_len(1024)
             .map(|(c, ((x, a), st))| {
                 let k = b.circle_body[c] as usize;
                 let off = b.circle_offset[c];

@@ -126,7 +126,11 @@ pub struct Stepper {
     deferred_start: Vec<u32>,
     /// Every body is a single circle at its centre (circle c = body c): fused fast paths.
     all_disks: bool,
-    wall_buf: Vec<(Vec2, f64)>,
+    /// Circles (ascending) that may reach a wall before the next search, the walls as they
+    /// were at that search, and whether the pair list was rebuilt since (`walls.rs`).
+    wall_near: Vec<u32>,
+    wall_ref: Vec<crate::wall::Wall>,
+    wall_stale: bool,
     kick: Vec<Kick>,
     n_circles: usize,
     n_bodies: usize,
@@ -440,7 +444,7 @@ impl Stepper {
         if simple {
             return;
         }
-        self.wall_forces(p.dt, wall_law, sys);
+        self.wall_forces(p.dt, p.skin, wall_law, sys);
         self.bond_forces(p.dt, sys);
         membrane::membrane_forces(sys);
         if let Some(hook) = hook {

@@ -83,6 +83,7 @@ impl Stepper {
             }
         }
         self.deferred_start.push(self.deferred.len() as u32);
+        self.wall_stale = true;
         self.rebuilds += 1;
         Ok(())
     }

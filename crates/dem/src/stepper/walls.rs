@@ -1,73 +1,96 @@
-//! Wall forces: the wall law between every circle and every wall (per circle in parallel), then
-//! a sequential sum in circle order onto the bodies and the walls.
+//! Wall forces: the wall law between the walls and the circles near them, in circle order, onto
+//! the bodies and the walls.
+//!
+//! A sample's walls touch few of its circles (the push-plate of Su's shear cell: about 1 % of
+//! them), so the pass keeps the circles that may reach a wall ([`Stepper::wall_near`]), found
+//! when the pair list is rebuilt or a wall has moved by half the skin since the last search,
+//! within the law's reach plus the skin (as the Verlet list: no circle or wall moves more than
+//! half the skin before the next search). Every other circle's wall history stays fresh. Only
+//! touching circles add to the sums, in ascending circle order: the result does not depend on
+//! when the search ran.
 
 use super::Stepper;
 use crate::contact::{ContactInput, ContactLaw};
 use crate::system::System;
-use crate::vector::Vec2;
-use rayon::prelude::*;
+use crate::vector::{Vec2, Vector};
+use crate::wall::{Wall, WallShape};
 
 impl Stepper {
-    pub(super) fn wall_forces<W: ContactLaw>(&mut self, dt: f64, wall_law: &W, sys: &mut System) {
+    pub(super) fn wall_forces<W: ContactLaw>(&mut self, dt: f64, skin: f64, wall_law: &W, sys: &mut System) {
         let nw = sys.walls.len();
         if nw == 0 {
             return;
         }
-        let (carm, cst) = (&self.carm, &self.cstate);
-        let b = &sys.bodies;
-        let walls = &sys.walls;
-        let hist = sys.contacts.wall_hist.conform::<W::History>(b.n_circles() * nw);
-        self.wall_buf.resize(b.n_circles() * nw, (Vec2::ZERO, 0.0));
-        self.wall_buf
-            .par_chunks_mut(nw)
-            .zip(hist.par_chunks_mut(nw))
-            .enumerate()
-            .with_min_len(256)
-            .for_each(|(c, (buf, hist))| {
-                let k = b.circle_body[c] as usize;
-                let r = b.circle_r[c];
-                let range = wall_law.wall_range(r);
-                for w in 0..nw {
-                    match walls[w].touch_within(cst[c].pos, r, range) {
-                        None => {
-                            hist[w] = W::History::default();
-                            buf[w] = (Vec2::ZERO, 0.0);
-                        }
-                        Some((delta, n)) => {
-                            let a = r - delta;
-                            let arm = carm[c] + n * a;
-                            let v = b.vel[k] + arm.spin(b.omega[k]);
-                            let ci = ContactInput {
-                                delta,
-                                n,
-                                v_rel: v - walls[w].vel,
-                                w_rel: b.omega[k],
-                                r_eff: r,
-                                m_eff: b.mass[k],
-                                dt,
-                            };
-                            let o = wall_law.force(&ci, &mut hist[w]);
-                            buf[w] = (o.f, arm.cross(o.f) + o.m_roll);
-                        }
-                    }
+        let nc = sys.bodies.n_circles();
+        let hist = sys.contacts.wall_hist.conform::<W::History>(nc * nw);
+        let stale = self.wall_ref.len() != nw
+            || self
+                .wall_ref
+                .iter()
+                .zip(&sys.walls)
+                .any(|(r, w)| (anchor(w) - anchor(r)).norm() > 0.5 * skin);
+        if self.wall_stale || stale {
+            // The circles that may reach a wall before the next search; the others' histories
+            // fresh (they touch no wall now).
+            let b = &sys.bodies;
+            self.wall_near.clear();
+            for c in 0..nc {
+                let (pos, r) = (self.cstate[c].pos, b.circle_r[c]);
+                let reach = r + wall_law.wall_range(r) + skin;
+                if sys.walls.iter().any(|w| w.may_touch(pos, reach)) {
+                    self.wall_near.push(c as u32);
+                } else {
+                    hist[c * nw..(c + 1) * nw].fill(W::History::default());
                 }
-            });
+            }
+            self.wall_ref.clone_from(&sys.walls);
+            self.wall_stale = false;
+        }
         let mut wf = vec![Vec2::ZERO; nw];
         let mut wn = vec![0u32; nw];
-        let bodies = &mut sys.bodies;
-        for c in 0..bodies.n_circles() {
-            let k = bodies.circle_body[c] as usize;
-            for (w, wfw) in wf.iter_mut().enumerate() {
-                let (f, t) = self.wall_buf[c * nw + w];
-                bodies.force[k] += f;
-                bodies.torque[k] += t;
-                *wfw -= f;
-                wn[w] += u32::from(f != Vec2::ZERO);
+        let (carm, cst) = (&self.carm, &self.cstate);
+        let b = &mut sys.bodies;
+        for &c in &self.wall_near {
+            let c = c as usize;
+            let k = b.circle_body[c] as usize;
+            let r = b.circle_r[c];
+            let range = wall_law.wall_range(r);
+            for (w, wall) in sys.walls.iter().enumerate() {
+                let h = &mut hist[c * nw + w];
+                let Some((delta, n)) = wall.touch_within(cst[c].pos, r, range) else {
+                    *h = W::History::default();
+                    continue;
+                };
+                let a = r - delta;
+                let arm = carm[c] + n * a;
+                let v = b.vel[k] + arm.spin(b.omega[k]);
+                let ci = ContactInput {
+                    delta,
+                    n,
+                    v_rel: v - wall.vel,
+                    w_rel: b.omega[k],
+                    r_eff: r,
+                    m_eff: b.mass[k],
+                    dt,
+                };
+                let o = wall_law.force(&ci, h);
+                b.force[k] += o.f;
+                b.torque[k] += arm.cross(o.f) + o.m_roll;
+                wf[w] -= o.f;
+                wn[w] += u32::from(o.f != Vec2::ZERO);
             }
         }
         for ((w, f), n) in sys.walls.iter_mut().zip(wf).zip(wn) {
             w.force = f;
             w.n_contacts = n;
         }
+    }
+}
+
+/// A point that moves with the wall (walls only translate).
+fn anchor(w: &Wall) -> Vec2 {
+    match w.shape {
+        WallShape::Plane { p, .. } => p,
+        WallShape::Segment { a, .. } => a,
     }
 }
