@@ -233,18 +233,7 @@ fn a_circle_beyond_the_domain_is_refused() {
 #[test]
 fn walls_give_the_same_bits_at_any_skin() {
     use lbdem_dem::wall::{Wall, WallMotion, WallShape};
-    let grain = ClumpShape {
-        balls: vec![
-            Ball {
-                centre: Vec2::new(-0.2, 0.0),
-                r: 0.4,
-            },
-            Ball {
-                centre: Vec2::new(0.25, 0.0),
-                r: 0.3,
-            },
-        ],
-    };
+    let grain = common::two_circle_grain();
     let mut bodies = Bodies::new();
     for k in 0..6 {
         bodies

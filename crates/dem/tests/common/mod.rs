@@ -27,11 +27,9 @@ pub fn bits(s: &System) -> Vec<u64> {
     v
 }
 
-/// Two-circle clumps and disks (3:1) inserted at random in a walled open box of side `side`,
-/// under gravity, with the linear law of the determinism tests: the general (non-disk) path of
-/// the stepper.
-pub fn clumps_in_walled_box(side: f64, count: usize, seed: u64) -> (System, LinearSpringDashpot, StepParams) {
-    let grain = ClumpShape {
+/// The two-circle grain (radii 0.4 and 0.3, centres 0.45 apart) of the clump tests.
+pub fn two_circle_grain() -> ClumpShape<Vec2> {
+    ClumpShape {
         balls: vec![
             Ball {
                 centre: Vec2::new(-0.2, 0.0),
@@ -42,7 +40,14 @@ pub fn clumps_in_walled_box(side: f64, count: usize, seed: u64) -> (System, Line
                 r: 0.3,
             },
         ],
-    };
+    }
+}
+
+/// Two-circle clumps and disks (3:1) inserted at random in a walled open box of side `side`,
+/// under gravity, with the linear law of the determinism tests: the general (non-disk) path of
+/// the stepper.
+pub fn clumps_in_walled_box(side: f64, count: usize, seed: u64) -> (System, LinearSpringDashpot, StepParams) {
+    let grain = two_circle_grain();
     let (lo, hi) = (Vec2::ZERO, Vec2::new(side, side));
     let bodies = generate::random_insert(
         &[grain, ClumpShape::disk(0.4)],
