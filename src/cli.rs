@@ -156,6 +156,21 @@ fn stage_command(name: &'static str, kind: &'static StageKind) -> Command {
     }
 }
 
+/// A refused run is a message for the user, not a crash: without this, RUST_BACKTRACE=1 (set in
+/// many Rust developers' shells) makes anyhow capture and print a stack backtrace under every
+/// refusal. Panics still follow RUST_BACKTRACE; RUST_LIB_BACKTRACE=1 brings the error backtraces
+/// back for whoever wants them. Both binaries (`lbdem`, `lbdem-mpi`) call it first.
+///
+/// # Safety
+/// Call it as the first statement of `main`, before the process has a second thread (it sets an
+/// environment variable).
+pub unsafe fn refusals_without_backtraces() {
+    if std::env::var_os("RUST_LIB_BACKTRACE").is_none() {
+        // SAFETY: the caller guarantees no other thread exists yet.
+        unsafe { std::env::set_var("RUST_LIB_BACKTRACE", "0") };
+    }
+}
+
 pub fn main() -> Result<()> {
     let m = command().get_matches();
     // A typo in LBDEM_ISA is refused before anything runs (the kernels would ignore it).

@@ -39,6 +39,8 @@ enum Command {
 }
 
 fn main() -> Result<()> {
+    // SAFETY: the first statement of `main`, before any thread of this process exists.
+    unsafe { lbdem::cli::refusals_without_backtraces() };
     let Command::Sweep {
         sweep,
         out,

@@ -1,5 +1,6 @@
-//! `lbdem-mpi` outside a launcher refuses before reading anything, naming how to start it; the
-//! MPI run itself is compared with `lbdem sweep` by scripts/mpi-sweep-check.sh (CI).
+//! `lbdem-mpi` outside a launcher refuses before reading anything, naming how to start it, with
+//! no stack backtrace under RUST_BACKTRACE=1; the MPI run itself is compared with `lbdem sweep`
+//! by scripts/mpi-sweep-check.sh (CI).
 
 use std::process::Command;
 
@@ -11,6 +12,8 @@ fn without_a_launcher_it_refuses_and_names_mpirun() {
         .env_remove("PMI_SIZE")
         .env_remove("PMIX_RANK")
         .env_remove("MPI_LOCALNRANKS")
+        .env("RUST_BACKTRACE", "1")
+        .env_remove("RUST_LIB_BACKTRACE")
         .output()
         .unwrap();
     assert!(!out.status.success());
@@ -18,5 +21,9 @@ fn without_a_launcher_it_refuses_and_names_mpirun() {
     assert!(
         err.contains("mpirun -n N lbdem-mpi sweep no-such-sweep.toml") && err.contains("lbdem sweep"),
         "{err}"
+    );
+    assert!(
+        !err.contains("backtrace"),
+        "a refusal is a message, not a crash: {err}"
     );
 }
