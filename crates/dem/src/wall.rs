@@ -125,6 +125,18 @@ impl Wall {
         }
     }
 
+    /// How far the wall is from where it was as `before`: the larger displacement of its points
+    /// (p, or a and b); infinite if its kind or its normal changed.
+    pub fn moved_from(&self, before: &Wall) -> f64 {
+        match (self.shape, before.shape) {
+            (WallShape::Plane { p, n }, WallShape::Plane { p: p0, n: n0 }) if n == n0 => (p - p0).norm(),
+            (WallShape::Segment { a, b }, WallShape::Segment { a: a0, b: b0 }) => {
+                (a - a0).norm().max((b - b0).norm())
+            }
+            _ => f64::INFINITY,
+        }
+    }
+
     /// Normal stress on a servo wall (N/m), compressive positive.
     pub fn stress(&self, length: f64) -> f64 {
         match self.shape {

@@ -2,18 +2,18 @@
 //! the bodies and the walls.
 //!
 //! A sample's walls touch few of its circles (the push-plate of Su's shear cell: about 1 % of
-//! them), so the pass keeps the circles that may reach a wall ([`Stepper::wall_near`]), found
-//! when the pair list is rebuilt or a wall has moved by half the skin since the last search,
-//! within the law's reach plus the skin (as the Verlet list: no circle or wall moves more than
-//! half the skin before the next search). Every other circle's wall history stays fresh. Only
-//! touching circles add to the sums, in ascending circle order: the result does not depend on
-//! when the search ran.
+//! them), so the pass keeps the circles that may reach a wall (`Stepper::wall_near`), searched
+//! when the pair list is rebuilt or a wall has moved by half the skin since the last search. The
+//! search reaches the law's reach plus 1.5 skins: until the next list rebuild every circle stays
+//! within half a skin of where the list was built, so within one skin of where the search saw it,
+//! and the walls within half a skin of theirs. Every other circle's wall history stays fresh.
+//! Only touching circles add to the sums, in ascending circle order: the result does not depend
+//! on when the search ran.
 
 use super::Stepper;
 use crate::contact::{ContactInput, ContactLaw};
 use crate::system::System;
-use crate::vector::{Vec2, Vector};
-use crate::wall::{Wall, WallShape};
+use crate::vector::Vec2;
 
 impl Stepper {
     pub(super) fn wall_forces<W: ContactLaw>(&mut self, dt: f64, skin: f64, wall_law: &W, sys: &mut System) {
@@ -28,7 +28,7 @@ impl Stepper {
                 .wall_ref
                 .iter()
                 .zip(&sys.walls)
-                .any(|(r, w)| (anchor(w) - anchor(r)).norm() > 0.5 * skin);
+                .any(|(r, w)| !(w.moved_from(r) <= 0.5 * skin));
         if self.wall_stale || stale {
             // The circles that may reach a wall before the next search; the others' histories
             // fresh (they touch no wall now).
@@ -36,7 +36,7 @@ impl Stepper {
             self.wall_near.clear();
             for c in 0..nc {
                 let (pos, r) = (self.cstate[c].pos, b.circle_r[c]);
-                let reach = r + wall_law.wall_range(r) + skin;
+                let reach = r + wall_law.wall_range(r) + 1.5 * skin;
                 if sys.walls.iter().any(|w| w.may_touch(pos, reach)) {
                     self.wall_near.push(c as u32);
                 } else {
@@ -84,13 +84,5 @@ impl Stepper {
             w.force = f;
             w.n_contacts = n;
         }
-    }
-}
-
-/// A point that moves with the wall (walls only translate).
-fn anchor(w: &Wall) -> Vec2 {
-    match w.shape {
-        WallShape::Plane { p, .. } => p,
-        WallShape::Segment { a, .. } => a,
     }
 }
