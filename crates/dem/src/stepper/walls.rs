@@ -24,11 +24,10 @@ impl Stepper {
         let nc = sys.bodies.n_circles();
         let hist = sys.contacts.wall_hist.conform::<W::History>(nc * nw);
         let stale = self.wall_ref.len() != nw
-            || self
-                .wall_ref
-                .iter()
-                .zip(&sys.walls)
-                .any(|(r, w)| !(w.moved_from(r) <= 0.5 * skin));
+            || self.wall_ref.iter().zip(&sys.walls).any(|(r, w)| {
+                let d = w.moved_from(r);
+                d.is_nan() || d > 0.5 * skin
+            });
         if self.wall_stale || stale {
             // The circles that may reach a wall before the next search; the others' histories
             // fresh (they touch no wall now).
