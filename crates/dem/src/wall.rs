@@ -111,12 +111,12 @@ impl Wall {
     /// for the circles near a wall (`stepper/walls.rs`).
     #[inline]
     pub fn may_touch(&self, c: Vec2, reach: f64) -> bool {
+        // The reach and a hair more than the round-off of a distance among these coordinates.
+        let grown = |scale: f64| reach + 1e-6 * reach.abs() + 1e-12 * scale;
         match self.shape {
-            WallShape::Plane { p, n } => {
-                (c - p).dot(n) < reach + 1e-6 * reach.abs() + 1e-12 * (p.x.abs() + p.y.abs())
-            }
+            WallShape::Plane { p, n } => (c - p).dot(n) < grown(p.x.abs() + p.y.abs()),
             WallShape::Segment { a, b } => {
-                let g = reach + 1e-6 * reach.abs() + 1e-12 * (a.x.abs() + a.y.abs() + b.x.abs() + b.y.abs());
+                let g = grown(a.x.abs() + a.y.abs() + b.x.abs() + b.y.abs());
                 c.x >= a.x.min(b.x) - g
                     && c.x <= a.x.max(b.x) + g
                     && c.y >= a.y.min(b.y) - g

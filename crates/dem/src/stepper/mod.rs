@@ -126,11 +126,10 @@ pub struct Stepper {
     deferred_start: Vec<u32>,
     /// Every body is a single circle at its centre (circle c = body c): fused fast paths.
     all_disks: bool,
-    /// Circles (ascending) that may reach a wall before the next search, the walls as they
-    /// were at that search, and whether the pair list was rebuilt since (`walls.rs`).
+    /// Circles (ascending) that may reach a wall before the next search, and the walls as they
+    /// were at that search (`walls.rs`).
     wall_near: Vec<u32>,
     wall_ref: Vec<crate::wall::Wall>,
-    wall_stale: bool,
     kick: Vec<Kick>,
     n_circles: usize,
     n_bodies: usize,

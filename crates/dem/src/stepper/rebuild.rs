@@ -15,7 +15,7 @@ impl Stepper {
         sys: &mut System,
         skin: f64,
         law: &L,
-        _wall_law: &W,
+        wall_law: &W,
     ) -> Result<(), DemError> {
         let b = &sys.bodies;
         if self.all_disks {
@@ -83,7 +83,7 @@ impl Stepper {
             }
         }
         self.deferred_start.push(self.deferred.len() as u32);
-        self.wall_stale = true;
+        self.find_wall_circles(sys, skin, wall_law);
         self.rebuilds += 1;
         Ok(())
     }

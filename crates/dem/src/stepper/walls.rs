@@ -16,35 +16,46 @@ use crate::system::System;
 use crate::vector::Vec2;
 
 impl Stepper {
+    /// The search: the circles that may reach a wall before the next one (`wall_near`), and
+    /// fresh wall histories for every other circle (they touch no wall now). Called by the
+    /// pair-list rebuild and, when a wall has moved half the skin, by [`Stepper::wall_forces`].
+    pub(super) fn find_wall_circles<W: ContactLaw>(&mut self, sys: &mut System, skin: f64, wall_law: &W) {
+        let (nc, nw) = (sys.bodies.n_circles(), sys.walls.len());
+        self.wall_near.clear();
+        self.wall_ref.clone_from(&sys.walls);
+        if nw == 0 {
+            return;
+        }
+        let hist = sys.contacts.wall_hist.conform::<W::History>(nc * nw);
+        let b = &sys.bodies;
+        for c in 0..nc {
+            let (pos, r) = (self.cstate[c].pos, b.circle_r[c]);
+            let reach = r + wall_law.wall_range(r) + 1.5 * skin;
+            if sys.walls.iter().any(|w| w.may_touch(pos, reach)) {
+                self.wall_near.push(c as u32);
+            } else {
+                hist[c * nw..(c + 1) * nw].fill(W::History::default());
+            }
+        }
+    }
+
     pub(super) fn wall_forces<W: ContactLaw>(&mut self, dt: f64, skin: f64, wall_law: &W, sys: &mut System) {
         let nw = sys.walls.len();
         if nw == 0 {
             return;
         }
-        let nc = sys.bodies.n_circles();
-        let hist = sys.contacts.wall_hist.conform::<W::History>(nc * nw);
-        let stale = self.wall_ref.len() != nw
+        let moved = self.wall_ref.len() != nw
             || self.wall_ref.iter().zip(&sys.walls).any(|(r, w)| {
                 let d = w.moved_from(r);
                 d.is_nan() || d > 0.5 * skin
             });
-        if self.wall_stale || stale {
-            // The circles that may reach a wall before the next search; the others' histories
-            // fresh (they touch no wall now).
-            let b = &sys.bodies;
-            self.wall_near.clear();
-            for c in 0..nc {
-                let (pos, r) = (self.cstate[c].pos, b.circle_r[c]);
-                let reach = r + wall_law.wall_range(r) + 1.5 * skin;
-                if sys.walls.iter().any(|w| w.may_touch(pos, reach)) {
-                    self.wall_near.push(c as u32);
-                } else {
-                    hist[c * nw..(c + 1) * nw].fill(W::History::default());
-                }
-            }
-            self.wall_ref.clone_from(&sys.walls);
-            self.wall_stale = false;
+        if moved {
+            self.find_wall_circles(sys, skin, wall_law);
         }
+        let hist = sys
+            .contacts
+            .wall_hist
+            .conform::<W::History>(sys.bodies.n_circles() * nw);
         let mut wf = vec![Vec2::ZERO; nw];
         let mut wn = vec![0u32; nw];
         let (carm, cst) = (&self.carm, &self.cstate);
