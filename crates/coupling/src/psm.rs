@@ -87,6 +87,9 @@ pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
     other: Vec<T>,
     /// Pull source of population i at node x: index of the upstream node, or `WALL | w`.
     src: Vec<u32>,
+    /// Per node: every population streams from its upstream node (`src` is x − c_i for each i),
+    /// so the step can pull by fixed offsets without reading `src`.
+    regular: Vec<bool>,
     /// Wall velocities (index 0: stationary inactive nodes; 1 + face for box walls).
     wall_u: Vec<[f64; 3]>,
     /// Inactive nodes (the domain's solid nodes, and the "solid zone" of Su Fig. 2 step 15 set
@@ -270,6 +273,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             nz,
             other: f.clone(),
             f,
+            regular: regular_nodes::<L>(&src, [nx, ny, nz]),
             src,
             wall_u,
             base_active: active.clone(),
@@ -409,6 +413,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
                 );
             }
         }
+        self.regular = regular_nodes::<L>(&self.src, [self.nx, self.ny, self.nz]);
         Ok(())
     }
 
@@ -518,8 +523,10 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
                         x,
                         i,
                     );
+                    self.regular[x] = is_regular::<L>(&self.src, [self.nx, self.ny, self.nz], x);
                 }
             }
+            self.regular[idx] = is_regular::<L>(&self.src, [self.nx, self.ny, self.nz], idx);
         }
         Ok(())
     }
@@ -661,6 +668,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             nz,
             f_in: &self.f,
             src: &self.src,
+            regular: &self.regular,
             wall_u: &self.wall_u,
             active: &self.active,
             map,
@@ -829,6 +837,29 @@ fn link<L: Lattice>(
     }
 }
 
+/// The node-index step from the node population i streams from to the node it streams to:
+/// c_x + nx c_y + nx ny c_z.
+#[inline(always)]
+fn pull_offset<L: Lattice>(i: usize, n: [usize; 3]) -> isize {
+    let c = L::C[i];
+    c[0] as isize + n[0] as isize * (c[1] as isize + n[1] as isize * c[2] as isize)
+}
+
+/// Whether every population of node `idx` streams from its upstream node without a wrap or a
+/// bounce-back (see `PsmFluid::regular`).
+fn is_regular<L: Lattice>(src: &[u32], n: [usize; 3], idx: usize) -> bool {
+    (0..L::Q).all(|i| {
+        let up = idx as isize - pull_offset::<L>(i, n);
+        up >= 0 && src[idx * L::Q + i] == up as u32
+    })
+}
+
+fn regular_nodes<L: Lattice>(src: &[u32], n: [usize; 3]) -> Vec<bool> {
+    (0..n[0] * n[1] * n[2])
+        .map(|idx| is_regular::<L>(src, n, idx))
+        .collect()
+}
+
 /// Offset x − c with the minimum-image convention on a periodic nx × ny lattice (harmless on
 /// walled boxes: grains never sit half a box away from the nodes they cover).
 #[inline]
@@ -881,6 +912,7 @@ struct Base<'a, T> {
     nz: usize,
     f_in: &'a [T],
     src: &'a [u32],
+    regular: &'a [bool],
     wall_u: &'a [[f64; 3]],
     active: &'a [bool],
     map: &'a SolidMap,
@@ -948,8 +980,55 @@ impl<T: Real, L: Lattice, C: Collider<L, f64>> WithSimd for ChunkOp<'_, T, L, C>
     }
 }
 
-/// One chunk of nodes: pull-stream (Su Eq. 12) with bounce-back from walls and inactive nodes,
-/// then the PSM collision of Su Eq. 9,
+/// Nodes collided side by side (as the lanes of `lbdem_lbm`'s collision): four f64 lanes fill
+/// an AVX2 register. Runs of fewer active nodes go one at a time through the same code.
+const LANES: usize = 4;
+
+/// The first node outside the limits: (node, ρ, u).
+type Bad = Option<(usize, f64, [f64; 3])>;
+
+/// One chunk of nodes: runs of [`LANES`] active nodes through [`nodes`] together, the rest one
+/// by one. A node's result does not depend on which way it went (the lanes do not mix).
+#[inline(always)] // into each instruction-set level's copy
+fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
+    b: &Base<T>,
+    coll: &C,
+    mut out: Chunk<T>,
+) -> Bad {
+    let q = L::Q;
+    // The lattice's velocities as floats (z = 0 in 2D).
+    let cf: [[f64; 3]; QMAX] = std::array::from_fn(|i| {
+        if i < q {
+            let c = L::C[i];
+            [
+                c[0] as f64,
+                c[1] as f64,
+                if L::D == 3 { c[2] as f64 } else { 0.0 },
+            ]
+        } else {
+            [0.0; 3]
+        }
+    });
+    let len = out.rho.len();
+    let mut first_bad = None;
+    let mut k = 0;
+    while k < len {
+        let idx = out.node0 + k;
+        if k + LANES <= len && b.active[idx..idx + LANES].iter().all(|&a| a) {
+            nodes::<T, L, C, F, LANES>(b, coll, &cf, &mut out, k, &mut first_bad);
+            k += LANES;
+        } else {
+            if b.active[idx] {
+                nodes::<T, L, C, F, 1>(b, coll, &cf, &mut out, k, &mut first_bad);
+            }
+            k += 1;
+        }
+    }
+    first_bad
+}
+
+/// `W` consecutive active nodes of a chunk, from its node `k`: pull-stream (Su Eq. 12) with
+/// bounce-back from walls and inactive nodes, then the PSM collision of Su Eq. 9,
 ///
 ///   f_i⁺ = f_i + (1 − B)(C(f)_i − f_i) + Σ_s B_s Ω_i^s,
 ///
@@ -958,118 +1037,193 @@ impl<T: Real, L: Lattice, C: Collider<L, f64>> WithSimd for ChunkOp<'_, T, L, C>
 /// node receives exactly (1 − B) F of momentum), B from Eq. 10, B_s = B ε_s / ε so that
 /// Σ_s B_s = B, and Ω^s the solid term of Eq. 11. The load on grain s is the reaction to the
 /// momentum Ω^s puts into the liquid (Eq. 14).
-#[inline(always)] // into each instruction-set level's copy
-fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
+///
+/// Ω_i^s = f_o − f_i + f_i^eq(ρ, u_s) − f_o^eq(ρ, u) is linear in B_s but for f_i^eq(ρ, u_s),
+/// which is quadratic in u_s: the sum over the grains needs only Σ B_s, Σ B_s u_s and
+/// Σ B_s u_s u_s, and the momentum grain s puts into the node, Σ_i B_s Ω_i^s c_i, is
+/// B_s (ρ u_s + ρ u − 2 j) with j = Σ f c (the equilibrium's first moment is exact). So each
+/// covering grain costs a few products, not a loop over the directions.
+#[inline(always)]
+fn nodes<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool, const W: usize>(
     b: &Base<T>,
     coll: &C,
-    out: Chunk<T>,
-) -> Option<(usize, f64, [f64; 3])> {
+    cf: &[[f64; 3]; QMAX],
+    out: &mut Chunk<T>,
+    k: usize,
+    first_bad: &mut Bad,
+) {
     let q = L::Q;
-    let Chunk {
-        node0,
-        f_out,
-        rho: rho_out,
-        u: u_out,
-        loads: load_out,
-    } = out;
-    let c0 = b.start[node0] as usize;
-    let mut first_bad = None;
-    for k in 0..rho_out.len() {
-        let idx = node0 + k;
-        if !b.active[idx] {
-            continue;
-        }
-        // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes (Leonardi Eq. 19).
-        let mut f = [0.0; QMAX];
+    let idx0 = out.node0 + k;
+    let c0 = b.start[out.node0] as usize;
+    // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes (Leonardi Eq. 19).
+    let mut f = [[0.0; W]; QMAX];
+    if b.regular[idx0..idx0 + W].iter().all(|&r| r) {
+        // Every lane pulls from its upstream nodes: the same values `src` names.
         for i in 0..q {
-            let s = b.src[idx * q + i];
-            f[i] = if s & WALL == 0 {
-                b.scale * b.f_in[s as usize * q + i].to_f64()
-            } else {
-                let uw = b.wall_u[(s & !WALL) as usize];
-                let c = L::C[i];
-                let o = L::OPP[i];
-                let mut cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1];
-                if L::D == 3 {
-                    cu += c[2] as f64 * uw[2];
-                }
-                b.scale * b.f_in[idx * q + o].to_f64() + 6.0 * L::W[i] * cu
-            };
+            let up = idx0 as isize - pull_offset::<L>(i, [b.nx, b.ny, b.nz]);
+            for w in 0..W {
+                f[i][w] = b.scale * b.f_in[(up as usize + w) * q + i].to_f64();
+            }
         }
-        // The liquid collision C(f) and the moments it used.
-        let mut post = [[0.0; 1]; QMAX];
+    } else {
         for i in 0..q {
-            post[i][0] = f[i];
-        }
-        let m = C::collide::<1, F>(coll, &mut post, idx);
-        let rho = m.rho[0];
-        let u = [m.u[0][0], m.u[1][0], m.u[2][0]];
-        let cover: &[CellCover] = &b.map.covers[b.start[idx] as usize..b.start[idx + 1] as usize];
-        let mut new = [0.0; QMAX];
-        if cover.is_empty() {
-            // B = 0: Eq. 9 is the liquid collision alone
-            for i in 0..q {
-                new[i] = post[i][0];
-            }
-        } else {
-            let eps = b.map.total[idx];
-            let tau = b.local_tau.map_or(b.tau, |t| t[idx]);
-            let weight = psm_weight(eps, tau);
-            for i in 0..q {
-                new[i] = f[i] + (1.0 - weight) * (post[i][0] - f[i]);
-            }
-            let usq = norm2::<L>(u);
-            let mut fe = [0.0; QMAX];
-            for i in 0..q {
-                fe[i] = feq::<L>(i, rho, u, usq);
-            }
-            // Solid part: Ω of Eq. 11 for each covering grain, weighted by B_s.
-            let x = [
-                (idx % b.nx) as f64 + 0.5,
-                ((idx / b.nx) % b.ny) as f64 + 0.5,
-                if L::D == 3 {
-                    (idx / (b.nx * b.ny)) as f64 + 0.5
+            for w in 0..W {
+                let idx = idx0 + w;
+                let s = b.src[idx * q + i];
+                f[i][w] = if s & WALL == 0 {
+                    b.scale * b.f_in[s as usize * q + i].to_f64()
                 } else {
-                    0.0
-                },
-            ];
-            for (mm, cv) in cover.iter().enumerate() {
-                let bs = weight * cv.fraction / eps;
-                let g = &b.grains[cv.body as usize];
-                let r = min_image3::<L>(x, g.centre, [b.nx, b.ny, b.nz]);
-                let us = velocity_at::<L>(g, r);
-                let ussq = norm2::<L>(us);
-                let mut p = [0.0; 3];
-                for i in 0..q {
-                    let o = L::OPP[i];
-                    let om = f[o] - f[i] + feq::<L>(i, rho, us, ussq) - fe[o];
-                    new[i] += bs * om;
-                    p[0] += bs * om * L::C[i][0] as f64;
-                    p[1] += bs * om * L::C[i][1] as f64;
+                    let uw = b.wall_u[(s & !WALL) as usize];
+                    let c = cf[i];
+                    let mut cu = c[0] * uw[0] + c[1] * uw[1];
                     if L::D == 3 {
-                        p[2] += bs * om * L::C[i][2] as f64;
+                        cu += c[2] * uw[2];
                     }
-                }
-                let fs = [-p[0], -p[1], -p[2]];
-                load_out[b.start[idx] as usize - c0 + mm] = ForceTorque {
-                    force: fs,
-                    torque: [
-                        r[1] * fs[2] - r[2] * fs[1],
-                        r[2] * fs[0] - r[0] * fs[2],
-                        r[0] * fs[1] - r[1] * fs[0],
-                    ],
+                    b.scale * b.f_in[idx * q + L::OPP[i]].to_f64() + 6.0 * L::W[i] * cu
                 };
             }
         }
-        let out = &mut f_out[k * q..(k + 1) * q];
-        for i in 0..q {
-            out[i] = T::from_f64(new[i]);
-        }
-        if !b.limits.accepts(rho, u) && first_bad.is_none() {
-            first_bad = Some((idx, rho, u));
-        }
-        rho_out[k] = rho;
-        u_out[k] = u;
     }
-    first_bad
+    // The liquid collision C(f) and the moments it used.
+    let mut post = f;
+    let m = C::collide::<W, F>(coll, &mut post, idx0);
+    // Per node: whether grains cover it, B (Eq. 10), and Σ B_s, Σ B_s u_s, Σ B_s u_s u_s (xx,
+    // yy, zz, xy, xz, yz) over its grains.
+    let mut covered = [false; W];
+    let mut eps = [0.0; W];
+    let mut tau = [b.tau; W];
+    for w in 0..W {
+        let idx = idx0 + w;
+        covered[w] = b.start[idx] != b.start[idx + 1];
+        eps[w] = b.map.total[idx];
+        if let Some(t) = b.local_tau {
+            tau[w] = t[idx];
+        }
+    }
+    let any_covered = covered.iter().any(|&c| c);
+    // B (Eq. 10) and B / ε, side by side (no cover: ε = 0 and B = 0).
+    let mut weight = [0.0; W];
+    let mut b_per_eps = [0.0; W];
+    // The pre-collision momentum j = Σ f c (u carries half the force as well).
+    let mut j = [[0.0; W]; 3];
+    if any_covered {
+        for w in 0..W {
+            weight[w] = psm_weight(eps[w], tau[w]);
+            b_per_eps[w] = if covered[w] { weight[w] / eps[w] } else { 0.0 };
+        }
+        for i in 0..q {
+            for a in 0..L::D {
+                for w in 0..W {
+                    j[a][w] += f[i][w] * cf[i][a];
+                }
+            }
+        }
+    }
+    let mut s0 = [0.0; W];
+    let mut s1 = [[0.0; W]; 3];
+    let mut s2 = [[0.0; W]; 6];
+    // The first node's lattice coordinates (one integer division per group, not per node).
+    let at = [idx0 % b.nx, (idx0 / b.nx) % b.ny, idx0 / (b.nx * b.ny)];
+    for w in 0..W {
+        if !covered[w] {
+            continue;
+        }
+        let idx = idx0 + w;
+        let cover: &[CellCover] = &b.map.covers[b.start[idx] as usize..b.start[idx + 1] as usize];
+        let rho = m.rho[w];
+        let u = [m.u[0][w], m.u[1][w], m.u[2][w]];
+        let j = [j[0][w], j[1][w], j[2][w]];
+        // The node's centre (lanes past the end of a row wrap onto the next).
+        let mut p = [at[0] + w, at[1], at[2]];
+        if p[0] >= b.nx {
+            p = [p[0] - b.nx, p[1] + 1, p[2]];
+            if p[1] >= b.ny {
+                p = [p[0], 0, p[2] + 1];
+            }
+        }
+        let x = [
+            p[0] as f64 + 0.5,
+            p[1] as f64 + 0.5,
+            if L::D == 3 { p[2] as f64 + 0.5 } else { 0.0 },
+        ];
+        let b_per_eps = b_per_eps[w];
+        for (mm, cv) in cover.iter().enumerate() {
+            let bs = b_per_eps * cv.fraction;
+            let g = &b.grains[cv.body as usize];
+            let r = min_image3::<L>(x, g.centre, [b.nx, b.ny, b.nz]);
+            let us = velocity_at::<L>(g, r);
+            s0[w] += bs;
+            let bu = [bs * us[0], bs * us[1], bs * us[2]];
+            s1[0][w] += bu[0];
+            s1[1][w] += bu[1];
+            s2[0][w] += bu[0] * us[0];
+            s2[1][w] += bu[1] * us[1];
+            s2[3][w] += bu[0] * us[1];
+            if L::D == 3 {
+                s1[2][w] += bu[2];
+                s2[2][w] += bu[2] * us[2];
+                s2[4][w] += bu[0] * us[2];
+                s2[5][w] += bu[1] * us[2];
+            }
+            let mut fs = [0.0; 3];
+            for a in 0..L::D {
+                fs[a] = -bs * (rho * (us[a] + u[a]) - 2.0 * j[a]);
+            }
+            out.loads[b.start[idx] as usize - c0 + mm] = ForceTorque {
+                force: fs,
+                torque: [
+                    r[1] * fs[2] - r[2] * fs[1],
+                    r[2] * fs[0] - r[0] * fs[2],
+                    r[0] * fs[1] - r[1] * fs[0],
+                ],
+            };
+        }
+    }
+    // The covered nodes' results overwrite `post` (which they read only at their own i).
+    if any_covered {
+        let mut usq = [0.0; W];
+        let mut trace = [0.0; W];
+        for w in 0..W {
+            usq[w] = m.u[0][w] * m.u[0][w] + m.u[1][w] * m.u[1][w];
+            if L::D == 3 {
+                usq[w] += m.u[2][w] * m.u[2][w];
+            }
+            trace[w] = s2[0][w] + s2[1][w] + s2[2][w];
+        }
+        for i in 0..q {
+            let o = L::OPP[i];
+            let c = cf[i];
+            for w in 0..W {
+                let (rho, u) = (m.rho[w], [m.u[0][w], m.u[1][w], m.u[2][w]]);
+                let mut cs1 = c[0] * s1[0][w] + c[1] * s1[1][w];
+                let mut cs2c = c[0] * c[0] * s2[0][w] + c[1] * c[1] * s2[1][w] + 2.0 * c[0] * c[1] * s2[3][w];
+                let mut cu = c[0] * u[0] + c[1] * u[1];
+                if L::D == 3 {
+                    cs1 += c[2] * s1[2][w];
+                    cs2c += c[2] * c[2] * s2[2][w] + 2.0 * (c[0] * c[2] * s2[4][w] + c[1] * c[2] * s2[5][w]);
+                    cu += c[2] * u[2];
+                }
+                // Σ_s B_s f_i^eq(ρ, u_s) and f_o^eq(ρ, u) (c_o = −c_i), Eq. 7.
+                let eq_s = L::W[i] * rho * (s0[w] + 3.0 * cs1 + 4.5 * cs2c - 1.5 * trace[w]);
+                let eq_o = L::W[o] * rho * (1.0 - 3.0 * cu + 4.5 * cu * cu - 1.5 * usq[w]);
+                let (fi, fo) = (f[i][w], f[o][w]);
+                let v = fi + (1.0 - weight[w]) * (post[i][w] - fi) + (s0[w] * (fo - fi - eq_o) + eq_s);
+                post[i][w] = if covered[w] { v } else { post[i][w] };
+            }
+        }
+    }
+    for w in 0..W {
+        let kk = k + w;
+        let dst = &mut out.f_out[kk * q..(kk + 1) * q];
+        for i in 0..q {
+            dst[i] = T::from_f64(post[i][w]);
+        }
+        let rho = m.rho[w];
+        let u = [m.u[0][w], m.u[1][w], m.u[2][w]];
+        if !b.limits.accepts(rho, u) && first_bad.is_none() {
+            *first_bad = Some((idx0 + w, rho, u));
+        }
+        out.rho[kk] = rho;
+        out.u[kk] = u;
+    }
 }
