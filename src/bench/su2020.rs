@@ -15,14 +15,93 @@ use std::time::Instant;
 /// LBM steps per repetition (the DEM alone runs the same number of DEM steps).
 const STEPS: usize = 20;
 
+/// The figures of one scene at one thread count.
+struct Measured {
+    scene: String,
+    threads: usize,
+    grains: usize,
+    lattice: [usize; 2],
+    ratio: usize,
+    /// Seconds per LBM step: coupled, DEM alone (`ratio` DEM steps), LBM alone.
+    coupled: f64,
+    dem: f64,
+    lbm: f64,
+    /// LBM steps per mean diameter of plate travel, and to the scene's stop (settling included).
+    per_d: f64,
+    to_stop: Option<(f64, f64)>,
+}
+
 pub fn run(a: &BenchArgs) -> Result<()> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let scene: PathBuf = match (&a.scene, a.quick) {
-        (Some(p), _) => p.clone(),
-        (None, true) => root.join("scenes/su2020/reduced-shear-cell.toml"),
-        (None, false) => root.join("scenes/su2020/sim1.toml"),
+    let reduced = root.join("scenes/su2020/reduced-shear-cell.toml");
+    // Two sizes (the case and the reduced cell CI runs), so the cost growth with size is on
+    // record beside the growth with threads (issue 18 item 6); `--quick`: the reduced cell only.
+    let scenes: Vec<PathBuf> = match (&a.scene, a.quick) {
+        (Some(p), false) => vec![p.clone(), reduced],
+        (Some(p), true) => vec![p.clone()],
+        (None, true) => vec![reduced],
+        (None, false) => vec![root.join("scenes/su2020/sim1.toml"), reduced],
     };
-    let mut l = load(&scene, &Default::default())?;
+    let mut out = Vec::new();
+    for scene in &scenes {
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+            let m = pool.install(|| measure(a, scene, threads))?;
+            out.push(m);
+        }
+    }
+    if let Some(j) = &a.json {
+        let rows: Vec<_> = out
+            .iter()
+            .map(|m| {
+                serde_json::json!({
+                    "scene": m.scene, "threads": m.threads, "grains": m.grains, "lattice": m.lattice,
+                    "ratio": m.ratio, "coupled_s_per_lbm_step": m.coupled, "dem_s": m.dem,
+                    "lbm_s": m.lbm, "s_per_d": m.coupled * m.per_d, "s_to_10d": 10.0 * m.coupled * m.per_d,
+                    "stop_m": m.to_stop.map(|t| t.0), "minutes_to_stop": m.to_stop.map(|t| t.1),
+                })
+            })
+            .collect();
+        std::fs::write(j, serde_json::to_string_pretty(&rows)?)
+            .with_context(|| format!("cannot write {}", j.display()))?;
+    }
+    // The growth with size and threads, one line per scene.
+    for pair in out.chunks(2) {
+        if let [one, two] = pair {
+            println!(
+                "su2020 {}: 2 threads take {:.2} of 1 thread's time per LBM step (coupled), {:.2} (DEM alone), {:.2} (LBM alone)",
+                one.scene,
+                two.coupled / one.coupled,
+                two.dem / one.dem,
+                two.lbm / one.lbm
+            );
+        }
+    }
+    if let [a1, _, b1, _] = &out[..] {
+        // Per grain and DEM step (the coupled step holds `ratio` of them) and per node of the
+        // LBM alone: the figures that stay comparable between the sizes.
+        let per_grain = |m: &Measured| m.coupled / (m.grains * m.ratio) as f64 * 1e9;
+        let per_node = |m: &Measured| m.lbm / (m.lattice[0] * m.lattice[1]) as f64 * 1e9;
+        println!(
+            "su2020 size, 1 thread: {} ({} grains) {:.0} ns per grain and DEM step coupled, {:.1} ns per node LBM alone; \
+             {} ({} grains) {:.0} and {:.1}",
+            a1.scene,
+            a1.grains,
+            per_grain(a1),
+            per_node(a1),
+            b1.scene,
+            b1.grains,
+            per_grain(b1),
+            per_node(b1)
+        );
+    }
+    Ok(())
+}
+
+/// The coupled case, its DEM alone and its LBM alone on `threads` threads (the caller's pool).
+fn measure(a: &BenchArgs, scene: &Path, threads: usize) -> Result<Measured> {
+    let mut l = load(scene, &Default::default())?;
+    l.scene.run.threads = threads;
     // The steps timed are the shear's: the plate moves from the first one. The settling is
     // counted in the time to the scene's stop, at the same cost per step.
     let settle = l
@@ -109,13 +188,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let per_d = d_mean / (speed * dt);
     println!(
         "su2020 {}: {grains} grains, lattice {} x {}, {ratio} DEM steps per LBM step, d = {:.0} um, \
-         plate {:.3e} m/s, {} threads",
+         plate {:.3e} m/s, {threads} threads",
         l.name,
         n[0],
         n[1],
         d_mean * 1e6,
         speed,
-        rayon::current_num_threads()
     );
     println!(
         "  coupled  {:9.3} ms per LBM step  {:9.1} s per d  {:9.1} min to 10 d",
@@ -125,13 +203,14 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     );
     // The scene's own stop may use another d̄ (the paper's Table 2, not the assembly's measured
     // one): the time to it, at the same rate per LBM step.
-    if let Some(w) = &l.scene.run.until_wall_moved {
+    let to_stop = l.scene.run.until_wall_moved.as_ref().map(|w| {
+        let minutes = c * (w.distance / speed + settle) / dt / 60.0;
         println!(
-            "  to the scene's stop, u_y = {:.3} mm, after {settle} s of settling: {:.1} min",
+            "  to the scene's stop, u_y = {:.3} mm, after {settle} s of settling: {minutes:.1} min",
             w.distance * 1e3,
-            c * (w.distance / speed + settle) / dt / 60.0
         );
-    }
+        (w.distance, minutes)
+    });
     println!(
         "  DEM only {:9.3} ms per {ratio} DEM steps ({:.2} of coupled)",
         dm * 1e3,
@@ -158,16 +237,16 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         part(3) * 1e3,
         part(4) * 1e3
     );
-    if let Some(j) = &a.json {
-        std::fs::write(
-            j,
-            serde_json::to_string_pretty(&serde_json::json!({
-                "scene": l.name, "grains": grains, "lattice": n, "ratio": ratio,
-                "coupled_s_per_lbm_step": c, "dem_s": dm, "lbm_s": lb,
-                "s_per_d": c * per_d, "s_to_10d": 10.0 * c * per_d,
-            }))?,
-        )
-        .with_context(|| format!("cannot write {}", j.display()))?;
-    }
-    Ok(())
+    Ok(Measured {
+        scene: l.name.clone(),
+        threads,
+        grains,
+        lattice: n,
+        ratio,
+        coupled: c,
+        dem: dm,
+        lbm: lb,
+        per_d,
+        to_stop,
+    })
 }
