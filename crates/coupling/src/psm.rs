@@ -647,16 +647,20 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
         );
         let q = L::Q;
         // Covers of cell c are covers[start[c]..start[c + 1]] (the map is sorted by cell).
+        // One pass over the covers: each cell's first cover is where the cell index first
+        // reaches it.
         let mut start = std::mem::take(&mut self.cover_start);
-        start.clear();
         start.resize(n + 1, 0);
-        for cv in &map.covers {
-            start[cv.cell as usize + 1] += 1;
+        let mut next = 0;
+        for (k, cv) in map.covers.iter().enumerate() {
+            let c = cv.cell as usize;
+            if c >= next {
+                start[next..=c].fill(k as u32);
+                next = c + 1;
+            }
         }
-        for c in 0..n {
-            start[c + 1] += start[c];
-        }
-        self.cover_load.clear();
+        start[next..].fill(map.covers.len() as u32);
+        // Every cover's load is written by the step (zero on inactive nodes): no clearing.
         self.cover_load.resize(map.covers.len(), ForceTorque::default());
 
         let forced = self.settings.force.iter().any(|&x| x != 0.0);
@@ -1020,6 +1024,11 @@ fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
         } else {
             if b.active[idx] {
                 nodes::<T, L, C, F, 1>(b, coll, &cf, &mut out, k, &mut first_bad);
+            } else {
+                // A closed node's grains take no load from it.
+                let c0 = b.start[out.node0] as usize;
+                let (lo, hi) = (b.start[idx] as usize - c0, b.start[idx + 1] as usize - c0);
+                out.loads[lo..hi].fill(ForceTorque::default());
             }
             k += 1;
         }
