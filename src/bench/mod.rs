@@ -52,7 +52,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// The scene to run (`su2020`; default scenes/su2020/sim1.toml, or the reduced cell with
-    /// --quick).
+    /// --quick); the reduced cell also runs beside it as the second size, unless --quick.
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// Write tables and charts here (`resolution`; default out/bench-resolution).

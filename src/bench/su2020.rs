@@ -2,7 +2,9 @@
 //! `scenes/su2020/sim1.toml`; `--quick`: the reduced cell CI runs) for a few LBM steps: the wall
 //! time per LBM step, per mean diameter of push-plate travel and to u_y = 10 d̄, beside the same
 //! case's DEM alone (the same DEM steps, no liquid) and LBM alone (the same lattice and solid
-//! zone, no grains), measured in the same run: the ratios say what each half costs.
+//! zone, no grains), measured in the same run: the ratios say what each half costs. Each scene
+//! runs on 1 and 2 threads, and the reduced cell runs beside any other scene as its second size
+//! (issue 18 item 6).
 
 use super::{BenchArgs, median};
 use crate::scenes::models::{coupled, dry::Dry};
@@ -36,7 +38,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let reduced = root.join("scenes/su2020/reduced-shear-cell.toml");
     // Two sizes (the case and the reduced cell CI runs), so the cost growth with size is on
     // record beside the growth with threads (issue 18 item 6); `--quick`: the reduced cell only.
+    let same = |p: &Path| std::fs::canonicalize(p).ok() == std::fs::canonicalize(&reduced).ok();
     let scenes: Vec<PathBuf> = match (&a.scene, a.quick) {
+        (Some(p), false) if same(p) => vec![p.clone()],
         (Some(p), false) => vec![p.clone(), reduced],
         (Some(p), true) => vec![p.clone()],
         (None, true) => vec![reduced],
