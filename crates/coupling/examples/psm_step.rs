@@ -6,6 +6,7 @@
 use lbdem_coupling::solid_fraction::{GrainCircle, solid_map};
 use lbdem_coupling::{GrainMotion, PsmFluid, PsmSettings};
 use lbdem_lbm::{Collision, Domain, Face, Limits};
+use rand::RngExt;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -28,13 +29,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         force: [0.0; 2],
         limits: Limits::default(),
     };
-    let mut seed = 7u64;
-    let mut rnd = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = lbdem_dem::generate::rng(7);
+    let mut rnd = || rng.random::<f64>();
     let (cols, rows) = (83, 84);
     let (sx, sy) = ((nx - 8) as f64 / cols as f64, (ny - 8) as f64 / rows as f64);
     let (mut circles, mut grains) = (Vec::new(), Vec::new());
