@@ -58,6 +58,7 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::matrix::Matrix>(&["matrix"], CliShape::ParamsFile),
     entry::<stages::tradeoffs::Tradeoffs>(&["tradeoffs"], CliShape::ParamsFile),
     entry::<stages::minimal_models::MinimalModels>(&["minimal-models"], CliShape::ParamsFile),
+    entry::<stages::extrusion::Extrusion>(&["extrusion"], CliShape::ParamsFile),
 ];
 
 /// The stage kind named `kind`, or an error listing the known ones.

@@ -2,12 +2,16 @@
 //! `spheres_<step>.csv`, one row per sphere: `id` (index in the system at that step), `frozen`
 //! (1 = wall grain), centre `x`, `y`, `z`, radius `r`, velocity `vx`, `vy`, `vz`, spin `wx`,
 //! `wy`, `wz`, and the total force of the last evaluation `fx`, `fy`, `fz` (on a wall grain:
-//! the paste's load on it); beside it `spheres_<step>.vtp` for ParaView.
+//! the paste's load on it), and the sphere's share of the force dipoles of Ness et al. (2017)
+//! Eq. 7, `w_ab` = −Σ r_a F_b (N m, compression positive; a pair's dipole split half to each
+//! sphere, `lbdem_dem::spheres::sphere_dipoles`) with its hydrodynamic part `wh_ab` (Eq. 7a),
+//! NaN in a snapshot taken before any recorded force evaluation; beside it `spheres_<step>.vtp`
+//! for ParaView.
 
 use crate::report::table::{Col, f64_column, read_table, u64_column, write_table};
 use anyhow::{Context, Result};
 use lbdem_core::vtk::{Array, Values, write_vtp_points};
-use lbdem_dem::spheres::SphereSystem;
+use lbdem_dem::spheres::{SphereDipole, SphereSystem};
 use std::path::{Path, PathBuf};
 
 /// The sphere table, column by column.
@@ -28,14 +32,27 @@ pub struct SphereTable {
     pub fx: Vec<f64>,
     pub fy: Vec<f64>,
     pub fz: Vec<f64>,
+    /// Dipole shares, component ab at index 3a + b (empty when the table has none).
+    pub w: [Vec<f64>; 9],
+    pub wh: [Vec<f64>; 9],
 }
+
+/// Names of the dipole columns, component ab at index 3a + b.
+pub const DIPOLE: [&str; 9] = [
+    "w_xx", "w_xy", "w_xz", "w_yx", "w_yy", "w_yz", "w_zx", "w_zy", "w_zz",
+];
+pub const DIPOLE_HYDRO: [&str; 9] = [
+    "wh_xx", "wh_xy", "wh_xz", "wh_yx", "wh_yy", "wh_yz", "wh_zx", "wh_zy", "wh_zz",
+];
 
 const F64: [&str; 13] = [
     "x", "y", "z", "r", "vx", "vy", "vz", "wx", "wy", "wz", "fx", "fy", "fz",
 ];
 
 impl SphereTable {
-    pub fn of(sys: &SphereSystem) -> Self {
+    /// The table of `sys`, with each sphere's dipole share from `dipoles` (one per sphere) or
+    /// NaN when `None` (no recorded force evaluation).
+    pub fn of(sys: &SphereSystem, dipoles: Option<&[SphereDipole]>) -> Self {
         let s = &sys.spheres;
         let mut t = Self::default();
         for k in 0..s.len() {
@@ -59,8 +76,20 @@ impl SphereTable {
             ]) {
                 col.push(x);
             }
+            let share = dipoles.and_then(|d| d.get(k));
+            for a in 0..3 {
+                for b in 0..3 {
+                    t.w[3 * a + b].push(share.map_or(f64::NAN, |d| d.total[a][b]));
+                    t.wh[3 * a + b].push(share.map_or(f64::NAN, |d| d.hydro[a][b]));
+                }
+            }
         }
         t
+    }
+
+    /// Whether the table carries dipole shares (snapshots written before they existed do not).
+    pub fn has_dipoles(&self) -> bool {
+        self.w.iter().chain(&self.wh).all(|c| c.len() == self.x.len())
     }
 
     fn f64_mut(&mut self) -> [&mut Vec<f64>; 13] {
@@ -91,11 +120,18 @@ impl SphereTable {
 
 /// Write `spheres_<step>.csv` and `.vtp` under `dir/snapshots/`; returns (kind, path relative
 /// to `dir`).
-pub fn write_spheres(dir: &Path, step: u64, sys: &SphereSystem) -> Result<Vec<(&'static str, PathBuf)>> {
-    let t = SphereTable::of(sys);
+pub fn write_spheres(
+    dir: &Path,
+    step: u64,
+    sys: &SphereSystem,
+    dipoles: Option<&[SphereDipole]>,
+) -> Result<Vec<(&'static str, PathBuf)>> {
+    let t = SphereTable::of(sys, dipoles);
     let csv = PathBuf::from(format!("snapshots/spheres_{step:09}.csv"));
     let mut cols = vec![("id", Col::U64(&t.id)), ("frozen", Col::U64(&t.frozen))];
     cols.extend(F64.iter().zip(t.f64_ref()).map(|(n, v)| (*n, Col::F64(v))));
+    cols.extend(DIPOLE.iter().zip(&t.w).map(|(n, v)| (*n, Col::F64(v))));
+    cols.extend(DIPOLE_HYDRO.iter().zip(&t.wh).map(|(n, v)| (*n, Col::F64(v))));
     write_table(&dir.join(&csv), &cols)?;
     let vtp = PathBuf::from(format!("snapshots/spheres_{step:09}.vtp"));
     let s = &sys.spheres;
@@ -125,6 +161,15 @@ pub fn read_spheres(path: &Path) -> Result<SphereTable> {
     };
     for (name, col) in F64.iter().zip(t.f64_mut()) {
         *col = f64_column(&df, name, path)?;
+    }
+    // The dipole columns are newer than the table: read when all are there.
+    if DIPOLE.iter().chain(&DIPOLE_HYDRO).all(|n| df.column(n).is_ok()) {
+        for (name, col) in DIPOLE.iter().zip(&mut t.w) {
+            *col = f64_column(&df, name, path)?;
+        }
+        for (name, col) in DIPOLE_HYDRO.iter().zip(&mut t.wh) {
+            *col = f64_column(&df, name, path)?;
+        }
     }
     Ok(t)
 }

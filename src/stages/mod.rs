@@ -7,6 +7,7 @@ pub mod analyse;
 pub mod assemble;
 pub mod compare;
 pub mod digitise;
+pub mod extrusion;
 pub mod matrix;
 pub mod mechanism_map;
 pub mod minimal_models;

@@ -14,7 +14,13 @@
 //!   cracking; Sect. 3.1), the dynamic-dilatancy law (Eq. 21), the experimental datasets of
 //!   Fig. 3j and the transition lines between classes ([`mechanism`]);
 //! - whether the contact network percolates ([`network`]).
+//!
+//! And what Ness et al. (2017) compute from an extruder's spheres: binned coarse-grained
+//! velocity, gradients, stress, dissipation and static zones ([`coarse`]), and the
+//! Benbow-Bridgwater fit of pressure drops against die velocity ([`benbow`]).
 
+pub mod benbow;
+pub mod coarse;
 pub mod cracking;
 pub mod error;
 pub mod mechanism;

@@ -7,7 +7,7 @@
 
 use lbdem_dem::spheres::{
     Domain3, LinearSpring, Lubricated, Lubrication, Partner, PlaneWall, SphereLaw, SphereStepParams,
-    SphereStepper, SphereSystem, dipole_stress,
+    SphereStepper, SphereSystem, dipole_stress, sphere_dipoles,
 };
 use lbdem_dem::{Vec3, Vector};
 
@@ -100,6 +100,28 @@ fn dipole_stress_of_a_compressed_lattice_equals_the_wall_load() {
     }
     // A contact law alone: no hydrodynamic part.
     assert_eq!(dipole_stress(rec, v, true), [[0.0; 3]; 3]);
+    // Each sphere's share (what a coarse-graining bin sums): the shares add up to V σ, and
+    // every sphere of this lattice carries the same σ_xx share, s k_n δ (its two x pairs, half
+    // each), whether it touches a wall or not.
+    let shares = sphere_dipoles(rec, &sys.spheres.frozen);
+    for (a, row) in sigma.iter().enumerate() {
+        for (b, sab) in row.iter().enumerate() {
+            let sum: f64 = shares.iter().map(|w| w.total[a][b]).sum();
+            let scale = by_hand * v;
+            // Measured: 0 (a) off the diagonal, ~1e-16 relative on it (summation order).
+            assert!(
+                (sum - sab * v).abs() < 1e-13 * scale,
+                "{a}{b}: {sum} vs {}",
+                sab * v
+            );
+        }
+    }
+    for w in &shares {
+        assert!(rel(w.total[0][0], s * k_n * delta) < 1e-12, "{}", w.total[0][0]);
+        assert_eq!(w.hydro, [[0.0; 3]; 3]);
+    }
+    // A record naming a sphere outside the table is skipped, not a panic.
+    assert_eq!(sphere_dipoles(rec, &[false]).len(), 1);
 }
 
 /// Two spheres across a lubrication gap: the one record carries all its force as hydrodynamic,

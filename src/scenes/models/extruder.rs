@@ -10,7 +10,7 @@ use crate::scenes::timeloop::{Model, Probe};
 use anyhow::{Context, Result};
 use lbdem_dem::Vector;
 use lbdem_dem::spheres::extruder::{ExtruderSpec, ExtruderState, Segment};
-use lbdem_dem::spheres::{SphereStepParams, SphereStepper, SphereSystem};
+use lbdem_dem::spheres::{SphereStepParams, SphereStepper, SphereSystem, sphere_dipoles};
 use std::path::{Path, PathBuf};
 
 pub struct Extruder {
@@ -21,6 +21,9 @@ pub struct Extruder {
     pub state: ExtruderState,
     stepper: SphereStepper<NessLaw>,
     stop_when_steady: bool,
+    /// Whether the last step recorded its interactions (a step taken with `fields`): the
+    /// snapshot's dipole shares are NaN otherwise.
+    recorded: bool,
 }
 
 impl Extruder {
@@ -54,6 +57,7 @@ impl Extruder {
             state,
             stepper: SphereStepper::new(),
             stop_when_steady: e.stop_when_steady,
+            recorded: false,
         })
     }
 
@@ -84,7 +88,10 @@ pub const COLUMNS: [&str; 17] = [
 ];
 
 impl Model for Extruder {
-    fn step(&mut self, _fields: bool) -> Result<()> {
+    fn step(&mut self, fields: bool) -> Result<()> {
+        // Interactions are recorded only on the steps an output reads (snapshots' dipoles).
+        self.stepper.record_contacts(fields);
+        self.recorded = false;
         self.state
             .step(
                 &self.spec,
@@ -93,7 +100,9 @@ impl Model for Extruder {
                 &mut self.stepper,
                 &mut self.sys,
             )
-            .map_err(|e| anyhow::anyhow!("extruder at step {}: {e}", self.sys.step))
+            .map_err(|e| anyhow::anyhow!("extruder at step {}: {e}", self.sys.step))?;
+        self.recorded = fields;
+        Ok(())
     }
     fn steps_done(&self) -> u64 {
         self.sys.step
@@ -142,7 +151,10 @@ impl Model for Extruder {
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {
-        write_spheres(dir, self.sys.step, &self.sys)
+        let shares = self
+            .recorded
+            .then(|| sphere_dipoles(self.stepper.contacts(), &self.sys.spheres.frozen));
+        write_spheres(dir, self.sys.step, &self.sys, shares.as_deref())
     }
     fn progress_note(&self) -> Option<String> {
         let m = self.state.measure(&self.spec, &self.sys);
@@ -177,6 +189,7 @@ impl Model for Extruder {
         self.sys = s.system;
         self.state = s.extruder;
         self.stepper = SphereStepper::new();
+        self.recorded = false;
         Ok(())
     }
 }

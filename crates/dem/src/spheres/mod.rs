@@ -46,5 +46,5 @@ pub use law::{
     Surface, TimeStepLimit,
 };
 pub use stepper::{SphereStepParams, SphereStepper, max_time_step};
-pub use stress::{ContactForce, Partner, dipole_stress};
+pub use stress::{ContactForce, Partner, SphereDipole, dipole_stress, sphere_dipoles};
 pub use system::{FREE, PlaneWall, SphereContacts, SphereSystem, Spheres};
