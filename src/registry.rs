@@ -59,6 +59,7 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::tradeoffs::Tradeoffs>(&["tradeoffs"], CliShape::ParamsFile),
     entry::<stages::minimal_models::MinimalModels>(&["minimal-models"], CliShape::ParamsFile),
     entry::<stages::extrusion::Extrusion>(&["extrusion"], CliShape::ParamsFile),
+    entry::<stages::extrusion::flow::ExtrusionFlow>(&["extrusion-flow"], CliShape::ParamsFile),
 ];
 
 /// The stage kind named `kind`, or an error listing the known ones.

@@ -227,6 +227,44 @@ fn the_wall_realisation_sweep_expands_to_thirty_checked_cases() {
     }
 }
 
+/// sweeps/ness2017-fig9.toml (the full Fig. 9 sweep over pipelines/ness2017-case.toml) expands to
+/// 6 cases x 3 forces x 5 wall seeds, each case's simulate stage on its own Table 1 file with its
+/// force and seed, its analysis reading that run; and the reduced flow sweep to its 4 forces.
+/// Nothing is run.
+#[test]
+fn the_fig9_sweeps_expand_to_checked_cases() {
+    use crate::sweep::{cases::expand, schema::Sweep};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let s = Sweep::load(&root.join("sweeps/ness2017-fig9.toml")).unwrap();
+    let t = tempfile::tempdir().unwrap();
+    let cases = expand(&s, t.path()).unwrap();
+    assert_eq!(cases.len(), 90);
+    let forces = [1.0e-6, 1.0e-5, 1.0e-4];
+    let mu_w = [0.0, 0.1, 0.0, 0.1, 0.0, 0.0];
+    for (k, c) in cases.iter().enumerate() {
+        let (case, force, seed) = (k / 15, forces[(k / 5) % 3], (k % 5) as u64 + 1);
+        let sim = &c.pipeline.stages[0].params;
+        let scene = sim["scene"].as_str().unwrap();
+        assert_eq!(
+            scene,
+            format!(
+                "scenes/ness2017/case-{}.toml",
+                ["a", "b", "c", "d", "e", "f"][case]
+            )
+        );
+        let l = crate::scenes::schema::load(&root.join(scene), sim["overrides"].as_table().unwrap()).unwrap();
+        let (e, su) = (l.scene.extruder.unwrap(), l.scene.suspension.unwrap());
+        assert_eq!(
+            (e.body_force, e.wall_seed, su.mu_w),
+            (force, seed, mu_w[case]),
+            "{scene}"
+        );
+        assert_eq!(c.pipeline.stages[1].params["runs"][0].as_str(), Some("sim"));
+    }
+    let s = Sweep::load(&root.join("sweeps/ness2017-reduced-flow.toml")).unwrap();
+    assert_eq!(expand(&s, t.path()).unwrap().len(), 4);
+}
+
 /// The reduced extruder run until its mass balance holds (stop_when_steady): insertion and
 /// removal rates over a 30 t window within 15 % with at least 100 grains out in the window.
 /// About 60-150 s in release on the shared 2-core machine; scripts/validate-all.sh.

@@ -9,6 +9,7 @@
 //! Fig. 9's axes and fits Benbow-Bridgwater.
 
 mod figures;
+pub mod flow;
 mod run;
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
