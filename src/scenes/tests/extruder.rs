@@ -121,8 +121,8 @@ fn interrupted_and_resumed_extruder_matches_uninterrupted_bitwise() {
     );
 }
 
-/// The same run on one thread and on two gives the same bits (the sphere engine and the
-/// driver are serial; this pins it should either become parallel).
+/// The same run on one thread and on two gives the same bits (the sphere engine's pair search
+/// and pair laws run on rayon's threads, their sums serially in list order).
 #[test]
 fn extruder_results_do_not_depend_on_the_thread_count() {
     let t = tempfile::tempdir().unwrap();

@@ -1,14 +1,19 @@
 //! Broad phase of the sphere engine: a linked-cell list (spheres counting-sorted by cell) builds
 //! a Verlet pair list with a skin. Pairs come out sorted (i < j, ascending), whatever the order
-//! the cells are visited in, so the force sums downstream run in a fixed order. Periodic axes
+//! the cells are visited in or how the spheres are shared among threads, so the force sums
+//! downstream run in a fixed order. Periodic axes
 //! use the minimum image; an axis with fewer than three cells visits each neighbour cell once.
 
 use super::domain::Domain3;
 use super::error::SphereError;
 use super::system::FREE;
 use crate::vector::{Vec3, Vector};
+use rayon::prelude::*;
 
 const MAX_CELLS: usize = 64 << 20;
+
+/// Spheres per parallel task of the pair search.
+const SPHERE_BLOCK: usize = 256;
 
 /// Scratch of the cell list.
 #[derive(Default, Debug, Clone)]
@@ -17,7 +22,6 @@ pub struct CellList3 {
     sorted: Vec<u32>,
     cell: Vec<u32>,
     fill: Vec<u32>,
-    nb: Vec<u32>,
 }
 
 impl CellList3 {
@@ -34,7 +38,7 @@ impl CellList3 {
         r: &[f64],
         owner: &[u32],
         skin: f64,
-        range: impl Fn(f64, f64) -> f64,
+        range: impl Fn(f64, f64) -> f64 + Sync,
         pairs: &mut Vec<[u32; 2]>,
     ) -> Result<(), SphereError> {
         pairs.clear();
@@ -136,13 +140,15 @@ impl CellList3 {
         // so a sphere whose y-neighbour layer lies across the face searches that layer's whole
         // x row (2 of every n_y layers do; the minimum image decides).
         let sheared = dom.shear.is_some();
-        for i in 0..n {
-            let c = self.cell[i] as usize;
+        let (cell, cell_start, sorted) = (&self.cell, &self.cell_start, &self.sorted);
+        // One sphere's partners j > i, ascending, appended to `out`.
+        let partners = |i: usize, nb: &mut Vec<u32>, out: &mut Vec<[u32; 2]>| {
+            let c = cell[i] as usize;
             let (cx, cy, cz) = (c % nc[0], (c / nc[0]) % nc[1], c / (nc[0] * nc[1]));
             let (xs, _, mx) = axis_nb(cx, 0);
             let (ys, y_across, my) = axis_nb(cy, 1);
             let (zs, _, mz) = axis_nb(cz, 2);
-            self.nb.clear();
+            nb.clear();
             let (pi, ri) = (pos[i], r[i]);
             for &z in &zs[..mz] {
                 for (&y, &y_across) in ys[..my].iter().zip(&y_across[..my]) {
@@ -154,8 +160,8 @@ impl CellList3 {
                     };
                     for x in row.chain(nbs.iter().copied()) {
                         let cc = (z * nc[1] + y) * nc[0] + x;
-                        let members = self.cell_start[cc] as usize..self.cell_start[cc + 1] as usize;
-                        for &j in &self.sorted[members] {
+                        let members = cell_start[cc] as usize..cell_start[cc + 1] as usize;
+                        for &j in &sorted[members] {
                             if (j as usize) <= i || same_clump(owner, i, j as usize) {
                                 continue;
                             }
@@ -163,14 +169,29 @@ impl CellList3 {
                             let rj = r[j as usize];
                             let rc = ri + rj + range(ri, rj) + skin;
                             if d.norm2() < rc * rc {
-                                self.nb.push(j);
+                                nb.push(j);
                             }
                         }
                     }
                 }
             }
-            self.nb.sort_unstable();
-            pairs.extend(self.nb.iter().map(|&j| [i as u32, j]));
+            nb.sort_unstable();
+            out.extend(nb.iter().map(|&j| [i as u32, j]));
+        };
+        // Spheres in blocks on rayon's threads, the blocks' pairs joined in sphere order: the
+        // list is the serial one whatever the thread count.
+        let blocks: Vec<Vec<[u32; 2]>> = (0..n.div_ceil(SPHERE_BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let (mut nb, mut out) = (Vec::new(), Vec::new());
+                for i in b * SPHERE_BLOCK..((b + 1) * SPHERE_BLOCK).min(n) {
+                    partners(i, &mut nb, &mut out);
+                }
+                out
+            })
+            .collect();
+        for b in &blocks {
+            pairs.extend_from_slice(b);
         }
         Ok(())
     }

@@ -17,11 +17,12 @@
 //!   body-frame free rotation);
 //! - `hook.rs`: user forces;
 //! - `validate.rs`: the consistency check of a state (checkpoints are user input);
-//! - `stepper.rs`: velocity Verlet, serial;
+//! - `stepper.rs`: velocity Verlet; the pair laws in parallel, their sums serial (the bits do
+//!   not depend on the thread count);
 //! - `stress.rs`: the per-contact forces of the last evaluation and the dipole stress sum.
 //!
 //! Validated against Chung & Ooi (2011) benchmarks 1-4 (`crates/dem/tests/chung_ooi.rs`,
-//! `docs/dem3d.md`); clumps in `crates/dem/tests/clumps.rs`. Not yet here: parallel passes,
+//! `docs/dem3d.md`); clumps in `crates/dem/tests/clumps.rs`. Not yet here:
 //! per-sphere materials.
 
 pub mod cells;

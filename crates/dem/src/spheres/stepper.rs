@@ -5,7 +5,9 @@
 //! ([`SphereLaw`], monomorphised: its `force` inlines into the pair loop); user forces through a
 //! [`SphereForceHook`].
 //!
-//! Serial: nothing here runs in parallel, so results do not depend on the thread count.
+//! Parallel where the time goes: the pair laws run on rayon's threads (each pair reads the
+//! spheres and writes only its own history), and their forces are then summed serially in list
+//! order, so results do not depend on the thread count (everything else is serial).
 //! Determinism: the pair list is sorted (i < j), every pair beyond the law's range is skipped
 //! (adds nothing) and wall contacts follow in wall order, so each sphere's force is summed in an
 //! order fixed by the set of interactions alone; and the list's reference positions live in the
@@ -21,6 +23,7 @@ use super::system::{FREE, SphereSystem, Spheres};
 use crate::history::Histories;
 use crate::neighbor::carry_history_into;
 use crate::vector::{Vec3, Vector};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Parameters of a step.
@@ -59,6 +62,8 @@ pub struct SphereStepper<L: SphereLaw> {
     records: Vec<ContactForce>,
     /// Whether force evaluations fill `records` ([`Self::record_contacts`]; off by default).
     record: bool,
+    /// The pair pass's per-pair results (scratch, list order).
+    hits: Vec<Option<PairHit>>,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
@@ -72,6 +77,7 @@ impl<L: SphereLaw> Default for SphereStepper<L> {
             checked: None,
             records: Vec::new(),
             record: false,
+            hits: Vec::new(),
             rebuilds: 0,
         }
     }
@@ -322,50 +328,23 @@ impl<L: SphereLaw> SphereStepper<L> {
         s.torque.fill(Vec3::ZERO);
         self.records.clear();
         let hist = c.hist.conform::<L::History>(c.pairs.len());
-        for (pair, h) in c.pairs.iter().zip(hist.iter_mut()) {
-            let (i, j) = (pair[0] as usize, pair[1] as usize);
-            // On a Lees-Edwards box the image of j across a y face moves at v_j + dv_j.
-            let (d, dv_j) = dom.min_image_moving(s.pos[j] - s.pos[i]);
-            let (ri, rj) = (s.radius[i], s.radius[j]);
-            let dist2 = d.norm2();
-            let reach = ri + rj + law.range(ri, rj);
-            if dist2 >= reach * reach || dist2 == 0.0 {
-                *h = L::History::default();
+        // The laws in parallel (each pair reads the spheres and writes only its own history),
+        // then the sums in list order, serially: the same additions in the same order whatever
+        // the thread count, so the bits do not depend on it.
+        {
+            let (s, pairs, dt) = (&*s, &c.pairs, p.dt);
+            pairs
+                .par_iter()
+                .zip(hist.par_iter_mut())
+                .with_min_len(PAIR_CHUNK)
+                .map(|(pair, h)| pair_response(law, &dom, s, cl, dt, *pair, h))
+                .collect_into_vec(&mut self.hits);
+        }
+        for (pair, hit) in c.pairs.iter().zip(&self.hits) {
+            let Some(PairHit { out, nrm, ai, aj, d }) = *hit else {
                 continue;
-            }
-            let dist = dist2.sqrt();
-            let nrm = d * (1.0 / dist);
-            let delta = ri + rj - dist;
-            // Arms to the contact point, halfway into the overlap (or across the gap): a_i + a_j
-            // = distance, so the pair conserves angular momentum.
-            let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
-            let v_j = s.vel[j] + dv_j;
-            let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (v_j + s.omega[j].cross(nrm * -aj));
-            let (fi, fj) = (s.frozen[i], s.frozen[j]);
-            // m* of a mobile-frozen pair is the mobile body's mass: the frozen one is immovable.
-            let m_eff = match (fi, fj) {
-                (false, true) => body_mass(s, cl, i),
-                (true, false) => body_mass(s, cl, j),
-                _ => {
-                    let (mi, mj) = (body_mass(s, cl, i), body_mass(s, cl, j));
-                    mi * mj / (mi + mj)
-                }
             };
-            let it = Interaction {
-                n: nrm,
-                delta,
-                r_i: ri,
-                r_j: rj,
-                r_eff: ri * rj / (ri + rj),
-                m_eff,
-                v_rel,
-                dv: s.vel[i] - v_j,
-                dw: s.omega[i] - s.omega[j],
-                wall: false,
-                frozen: fi || fj,
-                dt: p.dt,
-            };
-            let out = law.force(&it, h);
+            let (i, j) = (pair[0] as usize, pair[1] as usize);
             if self.record && out != Response::default() {
                 self.records.push(ContactForce {
                     i: pair[0],
@@ -446,6 +425,83 @@ impl<L: SphereLaw> SphereStepper<L> {
         user_forces(hook, sys.time, sys);
         gather_clumps(sys, p.gravity);
     }
+}
+
+/// Pairs per parallel task of the pair pass (a pair's law is ~100 ns: a task of this many
+/// amortises rayon's hand-off).
+const PAIR_CHUNK: usize = 512;
+
+/// What one pair's law returned, with what the sums need: the unit normal, the arms to the
+/// contact point and the branch vector.
+#[derive(Clone, Copy, Debug)]
+struct PairHit {
+    out: Response,
+    nrm: Vec3,
+    ai: f64,
+    aj: f64,
+    d: Vec3,
+}
+
+/// The law of the pair `pair` (i < j) at the spheres' present state, updating its history; None
+/// (and a fresh history) beyond the law's range.
+fn pair_response<L: SphereLaw>(
+    law: &L,
+    dom: &super::domain::Domain3,
+    s: &Spheres,
+    cl: &Clumps,
+    dt: f64,
+    pair: [u32; 2],
+    h: &mut L::History,
+) -> Option<PairHit> {
+    let (i, j) = (pair[0] as usize, pair[1] as usize);
+    // On a Lees-Edwards box the image of j across a y face moves at v_j + dv_j.
+    let (d, dv_j) = dom.min_image_moving(s.pos[j] - s.pos[i]);
+    let (ri, rj) = (s.radius[i], s.radius[j]);
+    let dist2 = d.norm2();
+    let reach = ri + rj + law.range(ri, rj);
+    if dist2 >= reach * reach || dist2 == 0.0 {
+        *h = L::History::default();
+        return None;
+    }
+    let dist = dist2.sqrt();
+    let nrm = d * (1.0 / dist);
+    let delta = ri + rj - dist;
+    // Arms to the contact point, halfway into the overlap (or across the gap): a_i + a_j
+    // = distance, so the pair conserves angular momentum.
+    let (ai, aj) = (ri - 0.5 * delta, rj - 0.5 * delta);
+    let v_j = s.vel[j] + dv_j;
+    let v_rel = (s.vel[i] + s.omega[i].cross(nrm * ai)) - (v_j + s.omega[j].cross(nrm * -aj));
+    let (fi, fj) = (s.frozen[i], s.frozen[j]);
+    // m* of a mobile-frozen pair is the mobile body's mass: the frozen one is immovable.
+    let m_eff = match (fi, fj) {
+        (false, true) => body_mass(s, cl, i),
+        (true, false) => body_mass(s, cl, j),
+        _ => {
+            let (mi, mj) = (body_mass(s, cl, i), body_mass(s, cl, j));
+            mi * mj / (mi + mj)
+        }
+    };
+    let it = Interaction {
+        n: nrm,
+        delta,
+        r_i: ri,
+        r_j: rj,
+        r_eff: ri * rj / (ri + rj),
+        m_eff,
+        v_rel,
+        dv: s.vel[i] - v_j,
+        dw: s.omega[i] - s.omega[j],
+        wall: false,
+        frozen: fi || fj,
+        dt,
+    };
+    Some(PairHit {
+        out: law.force(&it, h),
+        nrm,
+        ai,
+        aj,
+        d,
+    })
 }
 
 /// The mass that moves with sphere `k`: its own, or its clump's.
