@@ -263,6 +263,21 @@ fn the_fig9_sweeps_expand_to_checked_cases() {
     }
     let s = Sweep::load(&root.join("sweeps/ness2017-reduced-flow.toml")).unwrap();
     assert_eq!(expand(&s, t.path()).unwrap().len(), 4);
+    // The reduced Table 1 cases: each case's friction and stiffness reach its simulate stage.
+    let s = Sweep::load(&root.join("sweeps/ness2017-reduced-cases.toml")).unwrap();
+    let cases = expand(&s, t.path()).unwrap();
+    assert_eq!(cases.len(), 10);
+    let want = [(1.0, 0.0, 1e4), (1.0, 0.1, 1e4), (0.1, 0.0, 1e4), (0.1, 0.1, 1e4), (1.0, 0.0, 2e4)];
+    for (k, c) in cases.iter().enumerate() {
+        let sim = &c.pipeline.stages[0].params;
+        let l = crate::scenes::schema::load(
+            &root.join(sim["scene"].as_str().unwrap()),
+            sim["overrides"].as_table().unwrap(),
+        )
+        .unwrap();
+        let su = l.scene.suspension.unwrap();
+        assert_eq!((su.mu_p, su.mu_w, su.k_n), want[k / 2], "case {k}");
+    }
 }
 
 /// The reduced extruder run until its mass balance holds (stop_when_steady): insertion and
