@@ -5,6 +5,7 @@
 pub mod bandwidth;
 pub mod coupled;
 pub mod dem;
+pub mod free_surface;
 pub mod grains;
 pub mod lbm;
 pub mod radiograph;
@@ -34,6 +35,9 @@ pub enum Which {
     Su2020,
     /// PSM drag and permeability error against cells per grain diameter and wall time.
     Resolution,
+    /// D3Q19 free-surface step (3D dam break) against the plain D3Q19 kernel, with and without
+    /// the Bingham local tau.
+    FreeSurface,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -88,6 +92,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Which::Coupled => coupled::run(a),
         Which::Su2020 => su2020::run(a),
         Which::Resolution => resolution::run(a),
+        Which::FreeSurface => free_surface::run(a),
     }
 }
 

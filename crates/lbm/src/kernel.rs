@@ -73,6 +73,18 @@ pub struct SyncPtr<T>(pub *mut T);
 unsafe impl<T> Send for SyncPtr<T> {}
 unsafe impl<T> Sync for SyncPtr<T> {}
 
+impl<T> SyncPtr<T> {
+    /// Write `v` at offset `k`. Taking `self` whole keeps closures capturing the wrapper (which
+    /// may cross threads) rather than its raw pointer field.
+    ///
+    /// # Safety
+    /// `k` is inside the allocation, and no other thread reads or writes offset `k` meanwhile.
+    #[inline(always)]
+    pub unsafe fn write(self, k: usize, v: T) {
+        unsafe { *self.0.add(k) = v };
+    }
+}
+
 /// v + d on a periodic axis of n nodes, d in {-1, 0, 1} (compares, not a division: this runs
 /// 2Q times per row).
 #[inline(always)]

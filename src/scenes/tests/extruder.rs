@@ -267,7 +267,13 @@ fn the_fig9_sweeps_expand_to_checked_cases() {
     let s = Sweep::load(&root.join("sweeps/ness2017-reduced-cases.toml")).unwrap();
     let cases = expand(&s, t.path()).unwrap();
     assert_eq!(cases.len(), 10);
-    let want = [(1.0, 0.0, 1e4), (1.0, 0.1, 1e4), (0.1, 0.0, 1e4), (0.1, 0.1, 1e4), (1.0, 0.0, 2e4)];
+    let want = [
+        (1.0, 0.0, 1e4),
+        (1.0, 0.1, 1e4),
+        (0.1, 0.0, 1e4),
+        (0.1, 0.1, 1e4),
+        (1.0, 0.0, 2e4),
+    ];
     for (k, c) in cases.iter().enumerate() {
         let sim = &c.pipeline.stages[0].params;
         let l = crate::scenes::schema::load(

@@ -5,9 +5,9 @@
 //! mass left the band ([`convert`]).
 //!
 //! Each node writes only its own populations, mass and moments and reads only the previous state
-//! (a gather, not a scatter), so the sweep is independent of the order nodes are visited in; it
-//! runs sequentially here (the cases of this module are small) and the conversions run
-//! sequentially in node order, so a run is deterministic.
+//! (a gather, not a scatter), so the sweep is independent of the order nodes are visited in: it
+//! runs in blocks of nodes on rayon's threads, and the conversions run sequentially in node
+//! order, so a run gives the same bits on any number of threads.
 
 use super::cells::{FreeSurface, GAS, INTERFACE, LIQUID, WALL};
 use super::convert::{Conversions, ConvertScratch, convert};
@@ -18,9 +18,11 @@ use crate::bingham::{Bingham, BinghamRates};
 use crate::collision::{CollideParams, Collider};
 use crate::diagnosis::BadNode;
 use crate::domain::Face;
+use crate::kernel::SyncPtr;
 use crate::lattice::{Lattice, QMAX};
 use crate::plan::{Upstream, neighbour};
 use crate::stepper::Settings;
+use rayon::prelude::*;
 use std::marker::PhantomData;
 
 /// No neighbour (across a wall face) in the link table.
@@ -189,63 +191,97 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
     }
 
     /// Stream, exchange mass and collide every liquid and interface node into the `*_new`
-    /// arrays; the first node outside the limits, if any.
-    fn sweep<C: Collider<L, f64>, const F: bool>(&mut self, s: &FreeSurface<L>, coll: &C) -> Option<usize> {
+    /// arrays; the first node outside the limits, if any. Blocks of nodes run on rayon's
+    /// threads; each node reads only the previous state and writes only its own entries, and the
+    /// first bad node is the lowest over the blocks, so the result is the serial sweep's.
+    fn sweep<C: Collider<L, f64> + Sync, const F: bool>(
+        &mut self,
+        s: &FreeSurface<L>,
+        coll: &C,
+    ) -> Option<usize> {
         let n = s.nodes();
         let limits = self.settings.limits;
-        let mut bad = None;
-        for x in 0..n {
-            let kind = s.cell[x];
-            if kind != LIQUID && kind != INTERFACE {
-                self.mass_new[x] = 0.0;
-                self.rho_new[x] = s.rho[x];
-                self.u_new[x] = s.u[x];
-                continue;
-            }
-            let fill_x = s.fill(x);
-            let atm = if kind == INTERFACE {
-                atmosphere::<L>(self.params.rho_atm, s.u[x])
-            } else {
-                [0.0; QMAX]
-            };
-            let mut f = [[0.0f64; 1]; QMAX];
-            f[0][0] = s.f[x];
-            let mut dm = 0.0;
-            for i in 1..L::Q {
-                let o = L::OPP[i];
-                // upstream node x − c_i = x + c_ī, and the population x sends to it
-                let up = self.links[o * n + x];
-                let f_out = s.f[o * n + x];
-                f[i][0] = if up == NONE {
-                    f_out
-                } else {
-                    let up = up as usize;
-                    match s.cell[up] {
-                        WALL => f_out,
-                        GAS => from_gas::<L>(&atm, i, f_out),
-                        k => {
-                            let f_in = s.f[i * n + up];
-                            dm += link_exchange(link_weight(kind, fill_x, k, s.fill(up)), f_in, f_out);
-                            f_in
-                        }
+        let (links, rho_atm) = (&self.links[..], self.params.rho_atm);
+        let f_new = SyncPtr(self.f_new.as_mut_ptr());
+        self.mass_new
+            .par_chunks_mut(NODE_BLOCK)
+            .zip(self.rho_new.par_chunks_mut(NODE_BLOCK))
+            .zip(self.u_new.par_chunks_mut(NODE_BLOCK))
+            .enumerate()
+            .map(|(b, ((mass_new, rho_new), u_new))| {
+                let mut bad = None;
+                for (k, ((mass_out, rho_out), u_out)) in mass_new
+                    .iter_mut()
+                    .zip(rho_new.iter_mut())
+                    .zip(u_new.iter_mut())
+                    .enumerate()
+                {
+                    let x = b * NODE_BLOCK + k;
+                    let kind = s.cell[x];
+                    if kind != LIQUID && kind != INTERFACE {
+                        *mass_out = 0.0;
+                        *rho_out = s.rho[x];
+                        *u_out = s.u[x];
+                        continue;
                     }
-                };
-            }
-            let m = coll.collide::<1, F>(&mut f, x);
-            for i in 0..L::Q {
-                self.f_new[i * n + x] = f[i][0];
-            }
-            let (rho, u) = (m.rho[0], [m.u[0][0], m.u[1][0], m.u[2][0]]);
-            self.rho_new[x] = rho;
-            self.u_new[x] = u;
-            self.mass_new[x] = s.mass[x] + dm;
-            if bad.is_none() && !limits.accepts(rho, u) {
-                bad = Some(x);
-            }
-        }
-        bad
+                    let fill_x = s.fill(x);
+                    let atm = if kind == INTERFACE {
+                        atmosphere::<L>(rho_atm, s.u[x])
+                    } else {
+                        [0.0; QMAX]
+                    };
+                    let mut f = [[0.0f64; 1]; QMAX];
+                    f[0][0] = s.f[x];
+                    let mut dm = 0.0;
+                    for i in 1..L::Q {
+                        let o = L::OPP[i];
+                        // upstream node x − c_i = x + c_ī, and the population x sends to it
+                        let up = links[o * n + x];
+                        let f_out = s.f[o * n + x];
+                        f[i][0] = if up == NONE {
+                            f_out
+                        } else {
+                            let up = up as usize;
+                            match s.cell[up] {
+                                WALL => f_out,
+                                GAS => from_gas::<L>(&atm, i, f_out),
+                                k => {
+                                    let f_in = s.f[i * n + up];
+                                    dm +=
+                                        link_exchange(link_weight(kind, fill_x, k, s.fill(up)), f_in, f_out);
+                                    f_in
+                                }
+                            }
+                        };
+                    }
+                    let m = coll.collide::<1, F>(&mut f, x);
+                    for (i, fi) in f.iter().enumerate().take(L::Q) {
+                        // SAFETY: index i·n + x with x in this block only: no other task writes
+                        // it, and nothing reads `f_new` during the sweep.
+                        unsafe { f_new.write(i * n + x, fi[0]) };
+                    }
+                    let (rho, u) = (m.rho[0], [m.u[0][0], m.u[1][0], m.u[2][0]]);
+                    *rho_out = rho;
+                    *u_out = u;
+                    *mass_out = s.mass[x] + dm;
+                    if bad.is_none() && !limits.accepts(rho, u) {
+                        bad = Some(x);
+                    }
+                }
+                bad
+            })
+            .reduce(
+                || None,
+                |a, b| match (a, b) {
+                    (Some(a), Some(b)) => Some(a.min(b)),
+                    (a, b) => a.or(b),
+                },
+            )
     }
 }
+
+/// Nodes per parallel task of the free-surface sweep.
+const NODE_BLOCK: usize = 2048;
 
 /// True when no liquid node touches a gas node (the interface is closed).
 pub fn is_closed<L: Lattice>(s: &FreeSurface<L>) -> bool {
