@@ -100,6 +100,9 @@ pub struct BinSums {
     count: Array2<f64>,
     volume: Array2<f64>,
     vel: Array2<[f64; 3]>,
+    /// Σ V_p v and Σ V_p v_a v_b (grain volume times velocity): the kinetic stress.
+    vol_v: Array2<[f64; 3]>,
+    vol_vv: Array2<[f64; 9]>,
     w: Array2<[f64; 9]>,
     wh: Array2<[f64; 9]>,
 }
@@ -113,6 +116,8 @@ impl BinSums {
             count: Array2::zeros(sh),
             volume: Array2::zeros(sh),
             vel: Array2::from_elem(sh, [0.0; 3]),
+            vol_v: Array2::from_elem(sh, [0.0; 3]),
+            vol_vv: Array2::from_elem(sh, [0.0; 9]),
             w: Array2::from_elem(sh, [0.0; 9]),
             wh: Array2::from_elem(sh, [0.0; 9]),
         }
@@ -137,7 +142,14 @@ impl BinSums {
             };
             let k = [iy, ix];
             self.count[k] += 1.0;
-            self.volume[k] += 4.0 / 3.0 * std::f64::consts::PI * p.r.powi(3);
+            let vp = 4.0 / 3.0 * std::f64::consts::PI * p.r.powi(3);
+            self.volume[k] += vp;
+            for a in 0..3 {
+                self.vol_v[k][a] += vp * p.v[a];
+                for b in 0..3 {
+                    self.vol_vv[k][3 * a + b] += vp * p.v[a] * p.v[b];
+                }
+            }
             for (a, b) in self.vel[k].iter_mut().zip(p.v) {
                 *a += b;
             }
@@ -156,8 +168,9 @@ impl BinSums {
         self.snapshots
     }
 
-    /// The time-averaged fields; `None` before any snapshot.
-    pub fn fields(&self) -> Option<CoarseFields> {
+    /// The time-averaged fields, the grains of density `density` (kg/m³, for the kinetic
+    /// stress); `None` before any snapshot.
+    pub fn fields(&self, density: f64) -> Option<CoarseFields> {
         if self.snapshots == 0 {
             return None;
         }
@@ -173,6 +186,7 @@ impl BinSums {
             vel: [(); 3].map(|_| Array2::from_elem(sh, f64::NAN)),
             sigma: [(); 9].map(|_| Array2::zeros(sh)),
             sigma_hydro: [(); 9].map(|_| Array2::zeros(sh)),
+            sigma_kinetic: [(); 9].map(|_| Array2::from_elem(sh, f64::NAN)),
         };
         for iy in 0..sh.0 {
             for ix in 0..sh.1 {
@@ -180,6 +194,16 @@ impl BinSums {
                 if occupied(k) {
                     for a in 0..3 {
                         f.vel[a][k] = self.vel[k][a] / self.count[k];
+                    }
+                }
+                if occupied(k) {
+                    // Σ m v'_a v'_b about the bin's mass-weighted mean: Σ m v v − (Σ m v)(Σ m v)/Σ m.
+                    let (m, mv, mvv) = (self.volume[k], self.vol_v[k], self.vol_vv[k]);
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            let c = 3 * a + b;
+                            f.sigma_kinetic[c][k] = density * (mvv[c] - mv[a] * mv[b] / m) / (s * vb);
+                        }
                     }
                 }
                 for c in 0..9 {
@@ -211,6 +235,10 @@ pub struct CoarseFields {
     /// NaN where no particle was.
     pub sigma: [Array2<f64>; 9],
     pub sigma_hydro: [Array2<f64>; 9],
+    /// The kinetic (streaming) stress (1/V) Σ m v'_a v'_b about the bin's time-averaged mean
+    /// velocity (Pa, positive like a pressure in this convention), which Eq. 7 leaves out
+    /// (Ness: inertia negligible at St ≪ 1); NaN where no particle was.
+    pub sigma_kinetic: [Array2<f64>; 9],
 }
 
 /// Velocity gradient of the x-y plane, ∂v_a/∂x_b at [a][b] (1/s).
@@ -225,6 +253,12 @@ impl CoarseFields {
             .and(&self.vel[2])
             .for_each(|s, &y, &z| *s = (*s * *s + y * y + z * z).sqrt());
         s
+    }
+
+    /// The kinetic pressure tr σ_kinetic / 3.
+    pub fn kinetic_pressure(&self) -> Array2<f64> {
+        let s = &self.sigma_kinetic;
+        (&s[0] + &s[4] + &s[8]) / 3.0
     }
 
     /// P = (σ_xx + σ_yy + σ_zz)/3 of the total stress, or of its hydrodynamic part.
@@ -388,7 +422,7 @@ mod tests {
         let p = lattice(&g, |x, y| [rate * y + ext * x, -ext * y, 0.0], |_, _| [0.0; 9]);
         let mut sums = BinSums::new(g);
         sums.add_snapshot(&p).unwrap();
-        let f = sums.fields().unwrap();
+        let f = sums.fields(1000.0).unwrap();
         let gr = f.gradient();
         let want = [[ext, rate], [0.0, -ext]];
         for a in 0..2 {
@@ -420,7 +454,7 @@ mod tests {
         // Two snapshots of the same state average to it.
         sums.add_snapshot(&p).unwrap();
         sums.add_snapshot(&p).unwrap();
-        let f = sums.fields().unwrap();
+        let f = sums.fields(1000.0).unwrap();
         let pressure = f.pressure(false);
         let s = f.dissipation(&f.gradient());
         for k in [[0, 0], [3, 4], [7, 9]] {
@@ -446,12 +480,41 @@ mod tests {
         let p = lattice(&g, |_, _| [2.0, 0.0, 0.0], |_, _| [0.0; 9]);
         let mut sums = BinSums::new(g);
         sums.add_snapshot(&p).unwrap();
-        let f = sums.fields().unwrap();
+        let f = sums.fields(1000.0).unwrap();
         let want = f.phi[[0, 0]] * 2.0 * 8e-5;
         for x in [[0.0, 1e-5], [2e-5, 9e-5]] {
             assert!((f.flux_x(x) - want).abs() < 1e-12 * want, "{}", f.flux_x(x));
         }
         assert!(f.flux_x([1.0, 2.0]).is_nan());
+    }
+
+    /// Velocities ±δ about a mean U alternating within each bin: the kinetic stress is
+    /// ρ V_p Σ δ_a δ_b / V_bin, whatever U (fluctuations about the bin mean only).
+    #[test]
+    fn kinetic_stress_is_the_fluctuation_about_the_bin_mean() {
+        let g = grid();
+        let (u, d) = (3.0, 0.5);
+        let mut p = lattice(&g, |_, _| [u, 0.0, 0.0], |_, _| [0.0; 9]);
+        for (k, q) in p.iter_mut().enumerate() {
+            let sgn = if k % 2 == 0 { 1.0 } else { -1.0 };
+            q.v = [u + sgn * d, sgn * d, 0.0];
+        }
+        let mut sums = BinSums::new(g);
+        sums.add_snapshot(&p).unwrap();
+        let rho = 2500.0;
+        let f = sums.fields(rho).unwrap();
+        let vp = 4.0 / 3.0 * std::f64::consts::PI * (1e-6f64).powi(3);
+        let want = rho * 4.0 * vp * d * d / g.volume();
+        for c in [0, 1, 3, 4] {
+            // xx, xy, yx, yy all ρ V_p Σ δ² / V (δ_x = δ_y = ±δ together).
+            assert!(
+                (f.sigma_kinetic[c][[2, 3]] - want).abs() < 1e-9 * want,
+                "{c}: {}",
+                f.sigma_kinetic[c][[2, 3]]
+            );
+        }
+        assert!(f.sigma_kinetic[8][[2, 3]].abs() < 1e-12 * want);
+        assert!((f.kinetic_pressure()[[2, 3]] - 2.0 * want / 3.0).abs() < 1e-9 * want);
     }
 
     #[test]
@@ -461,7 +524,7 @@ mod tests {
         let p = lattice(&g, |x, _| [1e5 * x, 0.0, 0.0], |_, _| [0.0; 9]);
         let mut sums = BinSums::new(g);
         sums.add_snapshot(&p).unwrap();
-        let f = sums.fields().unwrap();
+        let f = sums.fields(1000.0).unwrap();
         let (zone, grains) = f.static_zone(8.0, 0.25, [0.0, 1.0], [0.0, 1.0]);
         // Two columns in the 4 rows with y-centre ≥ 0: 8 bins of 4 particles.
         assert_eq!(zone.iter().filter(|&&z| z).count(), 8);

@@ -349,9 +349,10 @@ fn the_extrusion_analysis_balances_the_wall_loads(t: &Path) {
     let balance = f("axial_force_p1") / f("wall_load_x");
     eprintln!(
         "{} snapshots; σ_xx at P1 × area / wall loads downstream = {balance:.4}; P = {p:?} Pa; flux {q:?} m²/s; \
-         contact share {:.4}; static grains {}; largest |St| {:.2}",
+         contact share {:.4}; kinetic / Eq. 7 pressure {:.2e}; static grains {}; largest |St| {:.2}",
         f("snapshots"),
         f("contact_pressure_share"),
+        f("kinetic_pressure_ratio"),
         f("static_grains"),
         f("max_stokes")
     );
@@ -365,6 +366,8 @@ fn the_extrusion_analysis_balances_the_wall_loads(t: &Path) {
     assert!(p[3].abs() < 0.01 * p[0], "{p:?}");
     // Measured 0.9965.
     assert!(f("contact_pressure_share") > 0.9);
+    // Inertia: the kinetic pressure is a small fraction of Eq. 7's (measured 9.0e-4).
+    assert!(f("kinetic_pressure_ratio") > 0.0 && f("kinetic_pressure_ratio") < 0.01);
     // Measured: P2 passes 0.958 of P1's flux (the inventory still grows); tolerance twice 4.2 %.
     assert!((q[1] / q[0] - 1.0).abs() < 0.085, "{q:?}");
     for fig in rec.output.figures.iter() {

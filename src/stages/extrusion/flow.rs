@@ -192,7 +192,12 @@ fn flow(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     for (k, _, _) in MEASURES {
         cols.push((k, pts.iter().map(|q| num(&q.a, k)).collect()));
     }
-    for k in ["static_grains", "max_stokes", "contact_pressure_share"] {
+    for k in [
+        "static_grains",
+        "max_stokes",
+        "contact_pressure_share",
+        "kinetic_pressure_ratio",
+    ] {
         cols.push((k, pts.iter().map(|q| num(&q.a, k)).collect()));
     }
     let mut table: Vec<(&str, Col)> = vec![("series", Col::Str(&series))];

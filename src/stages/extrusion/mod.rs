@@ -187,6 +187,9 @@ pub struct Measured {
     pub max_stokes: f64,
     /// Contact share of the pressure over the channel: Σ P_contact / Σ P.
     pub contact_pressure_share: f64,
+    /// The kinetic pressure over the Eq. 7 pressure, summed over the channel: how far from
+    /// Ness's inertia-free regime the run is.
+    pub kinetic_pressure_ratio: f64,
     /// Momentum balance downstream of P1: the axial force through the barrel there, mean σ_xx
     /// at P1 × W_b × depth (N), against the paste's x-load on every wall downstream (barrel,
     /// entry faces, die; from the series, N). Equal at steady state up to the barrel walls' load
@@ -271,7 +274,9 @@ fn analyse(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let fields = sums.fields().context("no snapshot was binned")?;
+    let fields = sums
+        .fields(runs[0].spec.paste.density)
+        .context("no snapshot was binned")?;
     let measured = measure(p, &runs, &from, &lay, stations, &fields)?;
     let out = &ctx.out_dir;
     let mut tables = Vec::new();
@@ -415,6 +420,14 @@ fn measure(
         static_fraction: p.static_fraction,
         max_stokes,
         contact_pressure_share: pcontact / ptot,
+        kinetic_pressure_ratio: f
+            .kinetic_pressure()
+            .iter()
+            .zip(pressure.iter())
+            .filter(|(k, p)| k.is_finite() && p.is_finite())
+            .map(|(k, _)| k)
+            .sum::<f64>()
+            / ptot,
         axial_force_p1,
         wall_load_x,
         station_flux,
@@ -469,6 +482,7 @@ fn write_fields(
     }
     cols.push(("pressure", flat(&f.pressure(false))));
     cols.push(("pressure_hydro", flat(&f.pressure(true))));
+    cols.push(("pressure_kinetic", flat(&f.kinetic_pressure())));
     cols.push(("n1", flat(&f.n1())));
     cols.push(("dissipation", flat(&f.dissipation(g))));
     let refs: Vec<(&str, &[f64])> = cols.iter().map(|(n, v)| (*n, v.as_slice())).collect();
