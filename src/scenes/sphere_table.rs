@@ -4,7 +4,7 @@
 //! `wy`, `wz`, and the total force of the last evaluation `fx`, `fy`, `fz` (on a wall grain:
 //! the paste's load on it), and the sphere's share of the force dipoles of Ness et al. (2017)
 //! Eq. 7, `w_ab` = −Σ r_a F_b (N m, compression positive; a pair's dipole split half to each
-//! sphere, wholly to the paste grain at a wall grain, `lbdem_dem::spheres::sphere_dipoles`) with
+//! sphere, the paste grain's arm's share at a wall grain, `lbdem_dem::spheres::sphere_dipoles`) with
 //! its hydrodynamic part `wh_ab` (Eq. 7a),
 //! NaN in a snapshot taken before any recorded force evaluation; beside it `spheres_<step>.vtp`
 //! for ParaView.

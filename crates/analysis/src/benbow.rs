@@ -35,6 +35,18 @@ pub fn line_fit(x: &[f64], y: &[f64], through_origin: bool) -> Result<LineFit> {
         ));
     }
     let n = x.len();
+    // A line needs spread in x: refuse x all (nearly) equal, where the normal equations are
+    // singular but round-off may leave a finite inverse.
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let spread: f64 = x.iter().map(|v| (v - mean).powi(2)).sum();
+    let scale: f64 = x.iter().map(|v| v * v).sum();
+    if !through_origin && spread <= 1e-12 * scale || scale == 0.0 {
+        return Err(AnalysisError::invalid(
+            "fit points",
+            n,
+            "do not fix a line (all x the same, or all zero): give points at different velocities",
+        ));
+    }
     let a = DMatrix::from_fn(n, p, |i, j| if j + 1 == p { x[i] } else { 1.0 });
     let b = DVector::from_column_slice(y);
     let ata = a.transpose() * &a;
@@ -209,6 +221,8 @@ mod tests {
         assert!((f.slope - 1.3).abs() < 1e-12);
         assert!(log_slope(&[1.0, 2.0], &[1.0, -1.0]).is_err());
         assert!(line_fit(&[1.0, 1.0, 1.0], &[1.0, 2.0, 3.0], false).is_err());
+        // Equal x that round-off leaves a finite inverse for.
+        assert!(line_fit(&[0.07, 0.07, 0.07], &[1.0, 2.0, 3.0], false).is_err());
         assert!(fit(&v, &dp, &dp, 0.0, 1.0).is_err());
     }
 }

@@ -437,7 +437,8 @@ mod tests {
     }
 
     /// Dipole shares summed per bin over the bin volume, averaged over snapshots; a Newtonian
-    /// stress σ = −2η D (compression positive) in simple shear dissipates S = η γ̇².
+    /// stress σ = −2η D (compression positive) in simple shear dissipates S = η γ̇², and with
+    /// σ_xy ≠ σ_yx only σ_yx (force along x on a plane normal to y, with ∂v_x/∂y) works.
     #[test]
     fn stress_is_the_binned_dipole_sum_and_dissipates_as_a_newtonian_fluid() {
         let g = grid();
@@ -468,6 +469,33 @@ mod tests {
             );
         }
         assert_eq!(f.n1()[[2, 2]], 0.0);
+        // An asymmetric stress: σ_xy = 3 τ, σ_yx = τ. S = −σ_yx γ̇ = η γ̇² still.
+        let p = lattice(
+            &g,
+            |_, y| [rate * y, 0.0, 0.0],
+            |_, _| {
+                [
+                    2.0 * q,
+                    3.0 * tau * q,
+                    0.0,
+                    tau * q,
+                    2.0 * q,
+                    0.0,
+                    0.0,
+                    0.0,
+                    2.0 * q,
+                ]
+            },
+        );
+        let mut sums = BinSums::new(g);
+        sums.add_snapshot(&p).unwrap();
+        let f = sums.fields(1000.0).unwrap();
+        let s = f.dissipation(&f.gradient());
+        assert!(
+            (s[[3, 4]] - eta * rate * rate).abs() < 1e-9 * eta * rate * rate,
+            "{}",
+            s[[3, 4]]
+        );
         // φ: four spheres of radius size/10 per bin.
         let phi = 4.0 * 4.0 / 3.0 * std::f64::consts::PI * (1e-6f64).powi(3) / g.volume();
         assert!((f.phi[[1, 1]] - phi).abs() < 1e-12 * phi);

@@ -103,7 +103,7 @@ fn dipole_stress_of_a_compressed_lattice_equals_the_wall_load() {
     // Each sphere's share (what a coarse-graining bin sums): the shares add up to V σ, and
     // every sphere of this lattice carries the same σ_xx share, s k_n δ (its two x pairs, half
     // each), whether it touches a wall or not.
-    let shares = sphere_dipoles(rec, &sys.spheres.frozen);
+    let shares = sphere_dipoles(rec, &sys.spheres.frozen, &sys.spheres.radius);
     for (a, row) in sigma.iter().enumerate() {
         for (b, sab) in row.iter().enumerate() {
             let sum: f64 = shares.iter().map(|w| w.total[a][b]).sum();
@@ -121,7 +121,7 @@ fn dipole_stress_of_a_compressed_lattice_equals_the_wall_load() {
         assert_eq!(w.hydro, [[0.0; 3]; 3]);
     }
     // A record naming a sphere outside the table is skipped, not a panic.
-    assert_eq!(sphere_dipoles(rec, &[false]).len(), 1);
+    assert_eq!(sphere_dipoles(rec, &[false], &[A]).len(), 1);
 }
 
 /// Two spheres across a lubrication gap: the one record carries all its force as hydrodynamic,

@@ -410,5 +410,5 @@ fn a_bingham_column_with_enough_yield_stress_stands() {
         weak > 10.0 && weak < 0.7 * newtonian,
         "{weak} against {newtonian}"
     );
-    assert!(d0 < 1e-12 && d1 < 1e-12, "mass drift {d0:e}, {d1:e}");
+    assert!(d0 < 1e-14 && d1 < 1e-14, "mass drift {d0:e}, {d1:e}");
 }

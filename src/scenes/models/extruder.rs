@@ -151,9 +151,13 @@ impl Model for Extruder {
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {
-        let shares = self
-            .recorded
-            .then(|| sphere_dipoles(self.stepper.contacts(), &self.sys.spheres.frozen));
+        let shares = self.recorded.then(|| {
+            sphere_dipoles(
+                self.stepper.contacts(),
+                &self.sys.spheres.frozen,
+                &self.sys.spheres.radius,
+            )
+        });
         write_spheres(dir, self.sys.step, &self.sys, shares.as_deref())
     }
     fn progress_note(&self) -> Option<String> {

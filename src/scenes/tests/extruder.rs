@@ -356,17 +356,18 @@ fn the_extrusion_analysis_balances_the_wall_loads(t: &Path) {
         f("static_grains"),
         f("max_stokes")
     );
-    // Measured 2026-11-29 on this 2.4e-5 s run, window from 1.2e-5 s: 0.967 (on 3e-5 s runs
+    // Measured 2026-11-29 on this 2.4e-5 s run, window from 1.2e-5 s: 0.966 (on 3e-5 s runs
     // 0.975 from 1.5e-5 s, 0.962 from 1e-5; 0.940 over 2.6-6e-5 s). The barrel walls' load
     // upstream of P1 (about a third of their 6e-4 N, against 5.2e-3 N in all) is in the wall
     // sum and not in the section: most of the 3.3 %. Tolerance twice that.
     assert!((balance - 1.0).abs() < 0.07, "momentum balance {balance}");
-    // Measured: 602 513, 541 156, 2 721, 80 Pa.
+    // Measured: 595 352, 536 270, 2 691, 80 Pa. A physical criterion (the open end is at zero
+    // pressure, Ness), not a tolerance on a measurement.
     assert!(p[0] > p[1] && p[1] > p[2] && p[2] > p[3], "{p:?}");
     assert!(p[3].abs() < 0.01 * p[0], "{p:?}");
-    // Measured 0.9965.
-    assert!(f("contact_pressure_share") > 0.9);
-    // Inertia: the kinetic pressure is a small fraction of Eq. 7's (measured 9.0e-4).
+    // Measured 0.9965. Ness's statement is the criterion: contacts carry more than the liquid.
+    assert!(f("contact_pressure_share") > 0.5);
+    // Inertia: the kinetic pressure is a small fraction of Eq. 7's (measured 9.1e-4).
     assert!(f("kinetic_pressure_ratio") > 0.0 && f("kinetic_pressure_ratio") < 0.01);
     // Measured: P2 passes 0.958 of P1's flux (the inventory still grows); tolerance twice 4.2 %.
     assert!((q[1] / q[0] - 1.0).abs() < 0.085, "{q:?}");
@@ -384,6 +385,7 @@ fn the_extrusion_analysis_balances_the_wall_loads(t: &Path) {
         "stations_d = [[5.0, 8.0], [9.0, 12.0], [20.0, 23.0], [27.0, 40.0]]",
     );
     assert!(format!("{:#}", bad.unwrap_err()).contains("stations_d"));
+    assert!(!t.join("bad").exists(), "a refused analysis left its directory");
     let snap = std::fs::read_dir(run.join("snapshots"))
         .unwrap()
         .map(|e| e.unwrap().path())

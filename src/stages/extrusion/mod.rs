@@ -41,7 +41,7 @@ pub struct Params {
     #[serde(default = "d::one")]
     pub bin_d: f64,
     /// The four pressure stations P1-P4 as [x0, x1] windows in d from the ram face; default
-    /// from the geometry (Ness's layout: P1 at 2.5-5 inlet lengths, P2 the half barrel width
+    /// from the geometry (Ness's layout: P1 at 2.5-5 inlet lengths, P2 the quarter barrel width
     /// upstream of the entry region, P3 the first 1.25 die widths of the die, P4 its last).
     #[serde(default)]
     pub stations_d: Option<[[f64; 2]; 4]>,
@@ -49,6 +49,9 @@ pub struct Params {
     /// counted within half a barrel width upstream of the die entry.
     #[serde(default = "d::quarter")]
     pub static_fraction: f64,
+    /// Fewest snapshots (over all runs) an average may rest on.
+    #[serde(default = "d::five")]
+    pub min_snapshots: usize,
 }
 
 mod d {
@@ -57,6 +60,9 @@ mod d {
     }
     pub fn quarter() -> f64 {
         0.25
+    }
+    pub fn five() -> usize {
+        5
     }
 }
 
@@ -207,7 +213,8 @@ fn analyse(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     }
     if !(p.bin_d > 0.0 && p.bin_d.is_finite() && p.static_fraction > 0.0 && p.static_fraction < 1.0) {
         bail!(
-            "bin_d = {}, static_fraction = {}: need a positive bin and a fraction in (0, 1)",
+            "parameters bin_d = {} and static_fraction = {}: bin_d must be a positive number of diameters (Ness: \
+             1) and static_fraction in (0, 1) (Ness: 0.25)",
             p.bin_d,
             p.static_fraction
         );
@@ -225,10 +232,18 @@ fn analyse(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         let (a, b) = (&runs[0].spec, &r.spec);
         let mut g = b.geometry;
         g.wall_seed = a.geometry.wall_seed;
-        if g != a.geometry || b.paste != a.paste || r.viscosity != runs[0].viscosity {
+        let mut drive = b.drive;
+        drive.seed = a.drive.seed;
+        let differs = [
+            ("geometry (beyond the wall seed)", g != a.geometry),
+            ("paste", b.paste != a.paste),
+            ("drive (body force, inlet)", drive != a.drive),
+            ("contact and lubrication law", r.law != runs[0].law),
+        ];
+        if let Some((what, _)) = differs.iter().find(|d| d.1) {
             bail!(
-                "runs {} and {} are not one case (geometry, paste or liquid differ beyond the wall seed): analyse \
-                 each case on its own",
+                "runs {} and {} are not one case: their {what} differ; analyse each case on its own (only the wall \
+                 and insertion seeds may differ between the runs averaged)",
                 runs[0].dir.display(),
                 r.dir.display()
             );
@@ -266,6 +281,16 @@ fn analyse(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
                 r.snapshots.len()
             );
         }
+    }
+    if chosen.len() < p.min_snapshots {
+        bail!(
+            "only {} sphere snapshot(s) at or after the window's start (from = {:?} s): an average needs \
+             min_snapshots = {}; give an earlier 'from', write snapshots more often ([output] snapshots), or run \
+             longer past the steady state (stop_when_steady = false)",
+            chosen.len(),
+            from,
+            p.min_snapshots
+        );
     }
     let bar = ctx.progress_bar(chosen.len() as u64, "snapshots");
     for (_, f) in &chosen {
@@ -370,7 +395,10 @@ fn measure(
     );
     if n_centre == 0 {
         bail!(
-            "no occupied bin on the barrel's centreline between P1 and P2: the barrel is empty in the window"
+            "no occupied bin on the barrel's centreline between P1 ({:?} d) and P2 ({:?} d): the barrel is empty in \
+             the averaging window; give a later 'from', or move the stations ('stations_d')",
+            stations[0],
+            stations[1]
         );
     }
     let x_entry = lay.barrel_length * d;

@@ -17,6 +17,8 @@ pub struct ExtruderRun {
     pub spec: ExtruderSpec,
     /// Liquid viscosity η_f (Pa s).
     pub viscosity: f64,
+    /// The contact and lubrication law as the run recorded it.
+    pub law: serde_json::Value,
     /// When the run's mass balance first held (s), if it did.
     pub first_steady: Option<f64>,
     /// Simulated time at the run's end (s).
@@ -70,10 +72,18 @@ impl ExtruderRun {
         let times = f64_column(&df, "time", &index)?;
         let kinds = df.column("kind")?.str()?.clone();
         let files = df.column("file")?.str()?.clone();
-        let mut snapshots: Vec<(f64, PathBuf)> = (0..steps.len())
-            .filter(|&k| kinds.get(k) == Some("spheres"))
-            .map(|k| (times[k], dir.join(files.get(k).unwrap_or_default())))
-            .collect();
+        let mut snapshots = Vec::new();
+        for k in (0..steps.len()).filter(|&k| kinds.get(k) == Some("spheres")) {
+            let file = files.get(k).with_context(|| {
+                format!(
+                    "{}: row {} (step {}) names no file",
+                    index.display(),
+                    k + 1,
+                    steps[k]
+                )
+            })?;
+            snapshots.push((times[k], dir.join(file)));
+        }
         snapshots.sort_by(|a, b| a.0.total_cmp(&b.0));
         let series_path = dir.join(crate::scenes::observers::SERIES_FILE);
         let series = read_table(&series_path)?;
@@ -81,6 +91,7 @@ impl ExtruderRun {
             dir: dir.to_path_buf(),
             spec,
             viscosity,
+            law: engine["law"].clone(),
             first_steady: engine["first_steady"].as_f64(),
             end_time: s["time"].as_f64().unwrap_or(f64::NAN),
             snapshots,

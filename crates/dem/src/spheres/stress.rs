@@ -10,7 +10,7 @@
 //! assembly in equilibrium equals Σ_walls x_c ⊗ F_c: the wall loads (the check in
 //! `crates/dem/tests/stress.rs`). Sign: compression positive, as Ness's Eq. 7 convention.
 
-use crate::vector::Vec3;
+use crate::vector::{Vec3, Vector};
 
 /// What the other side of an interaction is.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,15 +65,18 @@ pub struct SphereDipole {
     pub hydro: [[f64; 3]; 3],
 }
 
-/// Each sphere's share of the dipoles of `contacts` (one share per entry of `frozen`): a pair's
-/// −r ⊗ F split half to each sphere (the pair's dipole is the same seen from either side), a
-/// contact with a plane wall or a frozen (wall) grain wholly to the mobile sphere, so the walls'
-/// grains carry none and a paste grain at a wall of grains gets what it would at a plane wall.
+/// Each sphere's share of the dipoles of `contacts` (one share per entry of `frozen` and
+/// `radius`): a pair's −r ⊗ F split half to each sphere (the pair's dipole is the same seen from
+/// either side); a contact with a plane wall gives its sphere −a ⊗ F with a the arm to the
+/// contact point (the record's branch), and a contact with a frozen (wall) grain gives the
+/// mobile sphere the same, −(a_i/|r|) r ⊗ F with a_i = (r_i − r_j + |r|)/2 its arm to the
+/// contact point, so the walls' grains carry none and a paste grain at a wall of grains is
+/// counted as at a plane wall.
 /// Binned (Ness's coarse-graining: a sphere's share goes to the bin holding its centre) and
 /// divided by the bin volume, this is the bin's stress; summed over every sphere it is
 /// [`dipole_stress`] times the volume. Records naming a sphere past the table are skipped.
-pub fn sphere_dipoles(contacts: &[ContactForce], frozen: &[bool]) -> Vec<SphereDipole> {
-    let n = frozen.len();
+pub fn sphere_dipoles(contacts: &[ContactForce], frozen: &[bool], radius: &[f64]) -> Vec<SphereDipole> {
+    let n = frozen.len().min(radius.len());
     let mut w = vec![SphereDipole::default(); n];
     let mut add = |k: usize, share: f64, c: &ContactForce| {
         if let Some(d) = w.get_mut(k) {
@@ -95,9 +98,15 @@ pub fn sphere_dipoles(contacts: &[ContactForce], frozen: &[bool]) -> Vec<SphereD
             Partner::Sphere(j) => {
                 let (i, j) = (c.i as usize, j as usize);
                 let fixed = |k: usize| frozen.get(k).copied().unwrap_or(false);
+                // The mobile sphere's arm to the contact point over the centre distance.
+                let arm = |k: usize, o: usize| {
+                    let (rk, ro) = (radius.get(k).copied(), radius.get(o).copied());
+                    let d = c.branch.norm();
+                    rk.zip(ro).map_or(0.5, |(rk, ro)| 0.5 * (rk - ro + d) / d)
+                };
                 match (fixed(i), fixed(j)) {
-                    (false, true) => add(i, 1.0, c),
-                    (true, false) => add(j, 1.0, c),
+                    (false, true) => add(i, arm(i, j), c),
+                    (true, false) => add(j, arm(j, i), c),
                     _ => {
                         add(i, 0.5, c);
                         add(j, 0.5, c);
@@ -114,8 +123,9 @@ pub fn sphere_dipoles(contacts: &[ContactForce], frozen: &[bool]) -> Vec<SphereD
 mod tests {
     use super::*;
 
-    /// A pair record between sphere 0 and a frozen wall grain 1 gives sphere 0 the whole dipole
-    /// (as a plane wall would); between two mobile spheres each gets half; the sum is the same.
+    /// A pair record between sphere 0 (radius 1) and a frozen wall grain 1 (radius ½) one
+    /// apart (an overlap of ½) gives sphere 0 the dipole of its arm to the contact point, 3/4 of
+    /// the branch (as a plane wall would); between two mobile spheres each gets half.
     #[test]
     fn a_frozen_partner_leaves_the_whole_dipole_to_the_mobile_sphere() {
         let rec = [ContactForce {
@@ -126,16 +136,16 @@ mod tests {
             force: Vec3::new(-2.0, 0.5, 0.0),
             hydro: Vec3::new(-0.5, 0.0, 0.0),
         }];
-        let mobile = sphere_dipoles(&rec, &[false, false]);
-        let wall = sphere_dipoles(&rec, &[false, true]);
+        let r = [1.0, 0.5];
+        let mobile = sphere_dipoles(&rec, &[false, false], &r);
+        let wall = sphere_dipoles(&rec, &[false, true], &r);
         assert_eq!(mobile[0].total[0][0], 1.0);
         assert_eq!(mobile[1].total[0][1], -0.25);
-        assert_eq!(wall[0].total[0][0], 2.0);
-        assert_eq!(wall[0].hydro[0][0], 0.5);
-        assert_eq!(wall[1], SphereDipole::default());
         let sigma = dipole_stress(&rec, 1.0, false);
-        for share in [&mobile, &wall] {
-            assert_eq!(share[0].total[0][0] + share[1].total[0][0], sigma[0][0]);
-        }
+        assert_eq!(mobile[0].total[0][0] + mobile[1].total[0][0], sigma[0][0]);
+        // Arm (1 + 1 − 0.5)/2 = 0.75 of the unit branch.
+        assert_eq!(wall[0].total[0][0], 0.75 * 2.0);
+        assert_eq!(wall[0].hydro[0][0], 0.75 * 0.5);
+        assert_eq!(wall[1], SphereDipole::default());
     }
 }

@@ -41,7 +41,7 @@ pub fn dam_break(
     Ok((s, st))
 }
 
-/// The dam break on D3Q19 in a slab periodic in z (`nz` nodes deep): the same column, walls
+/// The dam break on D3Q19 in a box of `n` nodes, periodic in z: the same column, walls
 /// and hydrostatic start as [`dam_break`], every z-layer alike. What the free-surface benchmark
 /// runs (`lbdem bench free-surface`): a 3D box whose liquid, interface and gas all change.
 pub fn dam_break_3d(
