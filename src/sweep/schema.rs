@@ -246,6 +246,15 @@ impl Sweep {
                     a.name
                 )));
             }
+            // The tables' own columns: an axis of the same name would make two columns of one
+            // name, refused only after every case had run.
+            if ["case", "point", "seed"].contains(&a.name.as_str()) {
+                return Err(at(format!(
+                    "[[axis]] '{}': the name is a column every results table has (case, point, replica, seed); \
+                     rename the axis, e.g. '{}_'",
+                    a.name, a.name
+                )));
+            }
         }
         for p in placeholders(base.template()) {
             if !names.contains(p.as_str()) {

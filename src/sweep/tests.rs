@@ -115,6 +115,13 @@ fn the_sweep_file_refuses_what_cannot_work_and_says_why() {
             &["two axes are named 'a'"],
         ),
         (
+            &format!("{head}[[axis]]\nname = \"case\"\nkey = \"x\"\nvalues = [1, 2]\n"),
+            &[
+                "'case': the name is a column every results table has",
+                "rename the axis",
+            ],
+        ),
+        (
             "[sweep]\nscene = \"pk{pk}.toml\"\n",
             &["holds {pk}", "no [[axis]] is named 'pk'"],
         ),

@@ -25,7 +25,7 @@ pub struct Params {
     /// The stage of the sweep's pipeline that ran `extrusion`.
     #[serde(default = "d::stage")]
     pub stage: String,
-    /// The sweep axis whose values name the series (e.g. "case"); default: one series.
+    /// The sweep axis whose values name the series (e.g. "ness_case"); default: one series.
     #[serde(default)]
     pub series: Option<String>,
     /// More analyses (earlier `extrusion` stages or their directories), each a point of the
