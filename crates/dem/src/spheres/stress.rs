@@ -74,7 +74,9 @@ pub struct SphereDipole {
 /// counted as at a plane wall.
 /// Binned (Ness's coarse-graining: a sphere's share goes to the bin holding its centre) and
 /// divided by the bin volume, this is the bin's stress; summed over every sphere it is
-/// [`dipole_stress`] times the volume. Records naming a sphere past the table are skipped.
+/// [`dipole_stress`] times the volume when no partner is frozen (a frozen partner's share is
+/// the part of the branch beyond the contact point, left out). Records naming a sphere past the
+/// table are skipped.
 pub fn sphere_dipoles(contacts: &[ContactForce], frozen: &[bool], radius: &[f64]) -> Vec<SphereDipole> {
     let n = frozen.len().min(radius.len());
     let mut w = vec![SphereDipole::default(); n];
@@ -127,7 +129,7 @@ mod tests {
     /// apart (an overlap of ½) gives sphere 0 the dipole of its arm to the contact point, 3/4 of
     /// the branch (as a plane wall would); between two mobile spheres each gets half.
     #[test]
-    fn a_frozen_partner_leaves_the_whole_dipole_to_the_mobile_sphere() {
+    fn a_frozen_partner_leaves_the_mobile_sphere_its_arms_share() {
         let rec = [ContactForce {
             i: 0,
             j: Partner::Sphere(1),
