@@ -176,15 +176,8 @@ pub fn draw(
         .collect();
     // Fig. 3a with the static zones of Fig. 5 marked.
     let v_ref = m.centreline_velocity;
-    let (zone, _) = f.static_zone(
-        v_ref,
-        m.static_fraction,
-        [
-            (lay.barrel_length - 0.5 * lay.barrel_width) * lay.d,
-            lay.barrel_length * lay.d,
-        ],
-        [-0.5 * lay.barrel_width * lay.d, 0.5 * lay.barrel_width * lay.d],
-    );
+    let (zx, zy) = lay.static_window();
+    let (zone, _) = f.static_zone(v_ref, m.static_fraction, zx, zy);
     let mut shapes = vec![outline(lay)];
     shapes.extend(stations.iter().cloned());
     figs.push(draw_map(
@@ -274,7 +267,7 @@ pub fn draw(
         caption: format!("Speed across the barrel and the die, averaged over the x windows named (plug flow is flat). {src}."),
     });
     // Fig. 4: the four gradients as Stokes numbers at the die entry.
-    let st = run.spec.paste.density * lay.d * lay.d / run.viscosity;
+    let st = run.stokes_scale();
     for (file, name, a, b) in [
         ("stokes_xy.png", "St_xy = ρd²/η_f ∂V_x/∂y (Fig. 4a)", 0, 1),
         ("stokes_yx.png", "St_yx = ρd²/η_f ∂V_y/∂x (Fig. 4b)", 1, 0),

@@ -115,6 +115,14 @@ impl Layout {
         self.barrel_length + self.die_length
     }
 
+    /// Where static zones are counted (m): the barrel's last half width before the die entry,
+    /// across the barrel (Ness: "near the die entrance").
+    pub fn static_window(&self) -> ([f64; 2], [f64; 2]) {
+        let (d, x) = (self.d, self.barrel_length * self.d);
+        let h = 0.5 * self.barrel_width * d;
+        ([x - h, x], [-h, h])
+    }
+
     /// Half the channel's width at x (d).
     pub fn half_width(&self, x: f64) -> f64 {
         0.5 * if x < self.barrel_length {
@@ -401,14 +409,9 @@ fn measure(
             stations[1]
         );
     }
-    let x_entry = lay.barrel_length * d;
-    let (_, static_grains) = f.static_zone(
-        v_centre,
-        p.static_fraction,
-        [x_entry - 0.5 * lay.barrel_width * d, x_entry],
-        [-0.5 * lay.barrel_width * d, 0.5 * lay.barrel_width * d],
-    );
-    let scale = runs[0].spec.paste.density * d * d / runs[0].viscosity;
+    let (zx, zy) = lay.static_window();
+    let (_, static_grains) = f.static_zone(v_centre, p.static_fraction, zx, zy);
+    let scale = runs[0].stokes_scale();
     let grad = f.gradient();
     let max_stokes = grad
         .iter()
@@ -487,7 +490,7 @@ fn write_fields(
         }
     }
     let flat = |a: &ndarray::Array2<f64>| a.iter().copied().collect::<Vec<f64>>();
-    let st = run.spec.paste.density * lay.d * lay.d / run.viscosity;
+    let st = run.stokes_scale();
     let stokes = |a: &ndarray::Array2<f64>| a.iter().map(|v| v * st).collect::<Vec<f64>>();
     cols.push(("x_d", x));
     cols.push(("y_d", y));

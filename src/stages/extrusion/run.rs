@@ -100,6 +100,13 @@ impl ExtruderRun {
         })
     }
 
+    /// ρ d² / η_f (s), d the smaller diameter: times a velocity gradient, the Stokes number of
+    /// Ness's Fig. 4.
+    pub fn stokes_scale(&self) -> f64 {
+        let d = self.spec.paste.range()[0];
+        self.spec.paste.density * d * d / self.viscosity
+    }
+
     /// Start of the averaging window: `from` if given, else when the mass balance first held,
     /// else the second half of the run.
     pub fn window_start(&self, from: Option<f64>) -> f64 {
