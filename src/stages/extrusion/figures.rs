@@ -82,6 +82,44 @@ fn centreline(f: &CoarseFields, a: &Array2<f64>, lay: &Layout) -> (Vec<f64>, Vec
     (xs, vs)
 }
 
+/// A profile across the barrel beside the same across the die, against y (d).
+fn barrel_and_die(
+    path: &Path,
+    labels: [&str; 2],
+    barrel: &(Vec<f64>, Vec<f64>),
+    die: &(Vec<f64>, Vec<f64>),
+    title: &str,
+    y_label: &str,
+) -> Result<()> {
+    let [(lb, b), (ld, d)] = [(labels[0], barrel), (labels[1], die)];
+    let lines = [
+        Line {
+            label: lb,
+            x: &b.0,
+            y: &b.1,
+            style: Style::LinePoints,
+            colour: None,
+        },
+        Line {
+            label: ld,
+            x: &d.0,
+            y: &d.1,
+            style: Style::LinePoints,
+            colour: None,
+        },
+    ];
+    lines_png(
+        path,
+        &lines,
+        &LinesPlot {
+            title,
+            x_label: "y (d)",
+            y_label,
+            ..Default::default()
+        },
+    )
+}
+
 fn outline(lay: &Layout) -> Shape {
     let (b, w, e) = (0.5 * lay.barrel_width, 0.5 * lay.die_width, lay.end());
     Shape {
@@ -233,34 +271,15 @@ pub fn draw(
         path: "centreline.png".into(),
         caption: format!("Speed along y = 0 over V_barrel; the die carries about W_b/W_d = {:.1} times the barrel's. {src}.", lay.barrel_width / lay.die_width),
     });
-    let (by, bv) = across(f, &speed, lay, mid_barrel);
-    let (dy, dv) = across(f, &speed, lay, mid_die);
     let bl = format!("barrel, x {:.0}-{:.0} d", mid_barrel[0], mid_barrel[1]);
     let dl = format!("die, x {:.0}-{:.0} d", mid_die[0], mid_die[1]);
-    lines_png(
+    barrel_and_die(
         &out.join("plug.png"),
-        &[
-            Line {
-                label: &bl,
-                x: &by,
-                y: &bv,
-                style: Style::LinePoints,
-                colour: None,
-            },
-            Line {
-                label: &dl,
-                x: &dy,
-                y: &dv,
-                style: Style::LinePoints,
-                colour: None,
-            },
-        ],
-        &LinesPlot {
-            title: "Speed across the channel (Ness Fig. 3d-e)",
-            x_label: "y (d)",
-            y_label: "|V| / V_barrel (-)",
-            ..Default::default()
-        },
+        [&bl, &dl],
+        &across(f, &speed, lay, mid_barrel),
+        &across(f, &speed, lay, mid_die),
+        "Speed across the channel (Ness Fig. 3d-e)",
+        "|V| / V_barrel (-)",
     )?;
     figs.push(Figure {
         path: "plug.png".into(),
@@ -401,7 +420,7 @@ pub fn draw(
             false,
         ),
     ] {
-        let ((by, bv), (dy, dv)) = if ratio {
+        let (barrel, die) = if ratio {
             (ratio_across(mid_barrel), ratio_across(mid_die))
         } else {
             (
@@ -409,31 +428,7 @@ pub fn draw(
                 across(f, &f.phi, lay, mid_die),
             )
         };
-        lines_png(
-            &out.join(file),
-            &[
-                Line {
-                    label: &bl,
-                    x: &by,
-                    y: &bv,
-                    style: Style::LinePoints,
-                    colour: None,
-                },
-                Line {
-                    label: &dl,
-                    x: &dy,
-                    y: &dv,
-                    style: Style::LinePoints,
-                    colour: None,
-                },
-            ],
-            &LinesPlot {
-                title,
-                x_label: "y (d)",
-                y_label: ylab,
-                ..Default::default()
-            },
-        )?;
+        barrel_and_die(&out.join(file), [&bl, &dl], &barrel, &die, title, ylab)?;
         figs.push(Figure {
             path: file.into(),
             caption: format!(

@@ -6,7 +6,7 @@ use crate::LbmError;
 use crate::collision::Collision;
 use crate::domain::{Domain, Face};
 use crate::kernel::Limits;
-use crate::lattice::{CS2, D2Q9, D3Q19};
+use crate::lattice::{CS2, D2Q9, D3Q19, Lattice};
 use crate::stepper::Settings;
 
 /// The 2D dam break of Martin & Moyce (1952): a column `a` nodes wide and `2a` high against the
@@ -20,25 +20,7 @@ pub fn dam_break(
     g: f64,
     collision: Collision,
 ) -> Result<(FreeSurface<D2Q9>, FreeSurfaceStepper<D2Q9>), LbmError> {
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let dom = Domain::new(
-        [nx, ny, 1],
-        [wall, wall, wall, wall, Face::Periodic, Face::Periodic],
-    );
-    let params = FreeSurfaceParams::default();
-    let h = (2 * a) as f64;
-    let s = FreeSurface::<D2Q9>::new(dom, |p| {
-        let inside = p[0] < a && p[1] < 2 * a;
-        let rho = params.rho_atm + g / CS2 * (h - 0.5 - p[1] as f64).max(0.0);
-        (if inside { 1.0 } else { 0.0 }, rho, [0.0; 3])
-    })?;
-    let settings = Settings {
-        collision,
-        force: [0.0, -g, 0.0],
-        limits: Limits::default(),
-    };
-    let st = FreeSurfaceStepper::new(&s, settings, params)?;
-    Ok((s, st))
+    dam_break_in::<D2Q9>(a, [nx, ny, 1], g, collision)
 }
 
 /// The dam break on D3Q19 in a box of `n` nodes, periodic in z: the same column, walls
@@ -50,11 +32,21 @@ pub fn dam_break_3d(
     g: f64,
     collision: Collision,
 ) -> Result<(FreeSurface<D3Q19>, FreeSurfaceStepper<D3Q19>), LbmError> {
+    dam_break_in::<D3Q19>(a, n, g, collision)
+}
+
+/// The dam break on lattice `L` in a box of `n` nodes (walls on x and y, periodic in z).
+fn dam_break_in<L: Lattice>(
+    a: usize,
+    n: [usize; 3],
+    g: f64,
+    collision: Collision,
+) -> Result<(FreeSurface<L>, FreeSurfaceStepper<L>), LbmError> {
     let wall = Face::Wall { velocity: [0.0; 3] };
     let dom = Domain::new(n, [wall, wall, wall, wall, Face::Periodic, Face::Periodic]);
     let params = FreeSurfaceParams::default();
     let h = (2 * a) as f64;
-    let s = FreeSurface::<D3Q19>::new(dom, |p| {
+    let s = FreeSurface::<L>::new(dom, |p| {
         let inside = p[0] < a && p[1] < 2 * a;
         let rho = params.rho_atm + g / CS2 * (h - 0.5 - p[1] as f64).max(0.0);
         (if inside { 1.0 } else { 0.0 }, rho, [0.0; 3])
