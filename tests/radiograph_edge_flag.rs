@@ -85,7 +85,9 @@ fn flagged_revs_hold_the_edge_errors() {
         &s,
         lay.liquid_ref,
         lay.solid_ref,
-        r#"profiles = [{ name = "red", roi = [100, 0, 200, 512], axis = "y" }]"#,
+        // Every pixel's REV (the accuracy figures are per pixel; the default grid's cells are the
+        // same values at block centres, `a_map_on_the_default_grid_is_the_full_map_at_block_centres`).
+        "map_step = 1\nprofiles = [{ name = \"red\", roi = [100, 0, 200, 512], axis = \"y\" }]",
     );
     let out = tempfile::tempdir().unwrap();
     let ctx = StageContext::new(out.path().into(), "radiograph".into(), synth.path().into());
@@ -180,7 +182,7 @@ fn profile_fraction_counts_only_revs_with_eps_vol() {
         &s,
         flip(lay.liquid_ref),
         flip(lay.solid_ref),
-        r#"profiles = [{ name = "all", roi = [0, 0, 512, 512], axis = "y" }]"#,
+        "map_step = 1\nprofiles = [{ name = \"all\", roi = [0, 0, 512, 512], axis = \"y\" }]",
     );
     let out = tempfile::tempdir().unwrap();
     let ctx = StageContext::new(out.path().into(), "radiograph".into(), flipped.path().into());
@@ -343,7 +345,7 @@ fn dense_packing_is_flagged_at_its_edges_only() {
         truth.push(sat.rev_mean(rev_side, 0.5).unwrap());
     }
     let true_eps = eps_vol_field(truth[0].view(), truth[1].view(), 0.1);
-    let p = stage_params(dir.path(), &s, lay.liquid_ref, lay.solid_ref, "");
+    let p = stage_params(dir.path(), &s, lay.liquid_ref, lay.solid_ref, "map_step = 1");
     let out = tempfile::tempdir().unwrap();
     let ctx = StageContext::new(out.path().into(), "radiograph".into(), dir.path().into());
     let res = Radiograph::run(&p, &ctx).unwrap();
@@ -452,4 +454,89 @@ fn the_stage_gives_the_same_bytes_on_one_and_two_threads() {
             "{name} differs between a stack and numbered files"
         );
     }
+}
+
+/// The default map grid (issue 18 item 5): each map the stage writes holds, in every cell, the
+/// value of the every-pixel map (`map_step = 1`) at the cell's centre pixel, bit for bit; the
+/// summary's means and the profiles, formed over the cells, stay close to the every-pixel ones.
+#[test]
+fn a_map_on_the_default_grid_is_the_full_map_at_block_centres() {
+    let synth = tempfile::tempdir().unwrap();
+    let s = synth_set(synth.path(), "seed = 2\nthickness_change = -0.05\nplots = false");
+    let lay = lbdem::stages::synth::layout(&s).unwrap();
+    let prof = r#"profiles = [{ name = "red", roi = [100, 0, 200, 512], axis = "y" }]"#;
+    let run = |extra: &str| {
+        let p = stage_params(synth.path(), &s, lay.liquid_ref, lay.solid_ref, extra);
+        let out = tempfile::tempdir().unwrap();
+        let ctx = StageContext::new(out.path().into(), "radiograph".into(), synth.path().into());
+        let summary = Radiograph::run(&p, &ctx).unwrap().summary;
+        (out, summary)
+    };
+    let (full_dir, full) = run(&format!("map_step = 1\n{prof}"));
+    let (grid_dir, grid) = run(prof);
+    let k = grid["map_step_px"].as_u64().unwrap() as usize;
+    let side = full["rev_side_px"].as_u64().unwrap() as usize;
+    // A 95 px REV: cells of 5 px.
+    assert_eq!((side, k), (95, lbdem_imaging::rev::map_step_auto(side)));
+    assert_eq!(k, 5);
+    for name in [
+        "gs_rev_000.tif",
+        "gs_rev_001.tif",
+        "eps_vol_001.tif",
+        "near_edge_001.tif",
+    ] {
+        let (a, b) = (
+            read(&full_dir.path().join(name)),
+            read(&grid_dir.path().join(name)),
+        );
+        assert_eq!(b.dim(), (a.nrows() / k, a.ncols() / k), "{name}");
+        for ((i, j), &v) in b.indexed_iter() {
+            let w = a[[i * k + k / 2, j * k + k / 2]];
+            assert!(
+                (v.is_nan() && w.is_nan()) || v.to_bits() == w.to_bits(),
+                "{name} ({i}, {j}): {v} vs {w}"
+            );
+        }
+    }
+    // The means over the cells against those over every pixel. Measured (seed 2): g_S 1.36e-3
+    // (the cells leave out the last 2 rows and columns, and sample the pads' steep edges),
+    // eps_vol 4.7e-5 (of -0.0288), near-edge share 1.17e-3; tolerances twice those.
+    let (fa, ga) = (&full["per_frame"][1], &grid["per_frame"][1]);
+    for (key, tol) in [
+        ("g_s_rev_mean", 2.8e-3),
+        ("eps_vol_mean", 1e-4),
+        ("near_edge_fraction", 2.4e-3),
+    ] {
+        let (a, b) = (fa[key].as_f64().unwrap(), ga[key].as_f64().unwrap());
+        println!(
+            "{key}: every pixel {a:.6}, cells {b:.6}, difference {:.2e}",
+            (a - b).abs()
+        );
+        assert!((a - b).abs() < tol, "{key}: {a} vs {b}");
+    }
+    // The grid's profile points are every-pixel profile points (the cells' centre rows) averaged
+    // over the ROI's centre columns only. Measured: largest eps_vol difference 1.03e-3 (at the
+    // pads' edges, where eps_vol changes fastest across a row).
+    let col = |dir: &Path, c: &str| {
+        let path = dir.join("profile_red.csv");
+        table::f64_column(&table::read_table(&path).unwrap(), c, &path).unwrap()
+    };
+    let (ya, yb) = (col(full_dir.path(), "y_mm"), col(grid_dir.path(), "y_mm"));
+    let (ea, eb) = (
+        col(full_dir.path(), "eps_vol_001"),
+        col(grid_dir.path(), "eps_vol_001"),
+    );
+    assert_eq!(yb.len(), 512 / k);
+    let mut worst = 0.0f64;
+    for (y, e) in yb.iter().zip(&eb) {
+        let r = ya
+            .iter()
+            .position(|v| (v - y).abs() < 1e-9)
+            .expect("a cell's row is a pixel row");
+        if e.is_finite() || ea[r].is_finite() {
+            worst = worst.max((e - ea[r]).abs());
+        }
+    }
+    println!("profile eps_vol: largest difference {worst:.2e}");
+    assert!(worst < 2.1e-3, "profile eps_vol differs by {worst}");
 }

@@ -123,6 +123,14 @@ fn bad_inputs_are_named_and_nothing_is_written() {
     );
     expect_error(d.path(), "d_bar = 100e-6", &["REV side 316 px", "d_bar"]);
     expect_error(d.path(), "pixel_size = -1.0", &["pixel_size"]);
+    expect_error(d.path(), "map_step = 2", &["map_step", "odd"]);
+    expect_error(d.path(), "map_step = 0", &["map_step"]);
+    // A profile too thin to hold the centre of a 3 px map cell.
+    expect_error(
+        d.path(),
+        "map_step = 3\n[[profiles]]\nname = \"thin\"\nroi = [0, 0, 1, 32]\naxis = \"y\"",
+        &["profile 'thin'", "map cell", "map_step"],
+    );
 }
 
 #[test]

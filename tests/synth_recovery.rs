@@ -67,22 +67,29 @@ fn max_err(measured: &Array2<f64>, truth: &Array2<f64>) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// A true every-pixel map at the centre pixels of the stage's `k` px map cells.
+fn on_cells(truth: Array2<f64>, k: usize) -> Array2<f64> {
+    let (h, w) = truth.dim();
+    Array2::from_shape_fn((h / k, w / k), |(i, j)| truth[[i * k + k / 2, j * k + k / 2]])
+}
+
 fn run(thickness: Thickness, synth_dir: &Path, s: &SParams) -> (f64, f64, f64) {
     let out = tempfile::tempdir().unwrap();
     let ctx = StageContext::new(out.path().into(), "radiograph".into(), synth_dir.into());
-    Radiograph::run(&radiograph_params(synth_dir, s, thickness), &ctx).unwrap();
-    let e0 = max_err(
-        &read(&out.path().join("gs_rev_000.tif")),
-        &read(&synth_dir.join("true_gs_rev_000.tif")),
-    );
-    let e1 = max_err(
-        &read(&out.path().join("gs_rev_001.tif")),
-        &read(&synth_dir.join("true_gs_rev_001.tif")),
-    );
-    let ee = max_err(
-        &read(&out.path().join("eps_vol_001.tif")),
-        &read(&synth_dir.join("true_eps_vol_001.tif")),
-    );
+    let summary = Radiograph::run(&radiograph_params(synth_dir, s, thickness), &ctx)
+        .unwrap()
+        .summary;
+    // The stage's default map grid (5 px cells for this 95 px REV).
+    let k = summary["map_step_px"].as_u64().unwrap() as usize;
+    let err = |map: &str, truth: &str| {
+        max_err(
+            &read(&out.path().join(map)),
+            &on_cells(read(&synth_dir.join(truth)), k),
+        )
+    };
+    let e0 = err("gs_rev_000.tif", "true_gs_rev_000.tif");
+    let e1 = err("gs_rev_001.tif", "true_gs_rev_001.tif");
+    let ee = err("eps_vol_001.tif", "true_eps_vol_001.tif");
     println!("{thickness:?}: max |g_S error| frame 0 {e0:.5}, frame 1 {e1:.5}; max |eps_vol error| {ee:.5}");
     (e0, e1, ee)
 }
@@ -96,8 +103,10 @@ fn thickness_corrected_solid_fraction_and_strain_match_truth() {
 
     for t in [Thickness::Eq2, Thickness::Eq3] {
         let (e0, e1, ee) = run(t, dir.path(), &s);
-        // Measured: g_S 0.0073 / 0.0072 (Eq. 2), 0.0073 / 0.0070 (Eq. 3); eps_vol 0.0033 (Eq. 2),
-        // 0.0046 (Eq. 3): the 0.005 the docs state for eps_vol is what is asserted.
+        // Measured on the default 5 px cells: g_S 0.0057 / 0.0056 (Eq. 2), 0.0057 / 0.0054
+        // (Eq. 3); eps_vol 0.0027 (Eq. 2), 0.0042 (Eq. 3). Over every pixel (`map_step = 1`):
+        // g_S 0.0073 / 0.0072 and 0.0073 / 0.0070, eps_vol 0.0033 and 0.0046. The limits the docs
+        // state (0.01, 0.005) are what is asserted.
         assert!(e0 < 0.01 && e1 < 0.01, "{t:?}: g_S errors {e0} {e1} exceed 0.01");
         assert!(ee < 0.005, "{t:?}: eps_vol error {ee} exceeds 0.005");
     }

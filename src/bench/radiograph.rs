@@ -7,6 +7,12 @@
 //! SAT pass: u16 frame read twice (strip totals, then strip prefixes) 2 x 2, table written
 //! once 8 (`Sat::build_u16`); fused REV window and Eq. (5) pass: read 2 x 8 (top and bottom
 //! SAT rows) + 8 (g0), write 8 (g_S) + 8 (eps): 52 B/px.
+//!
+//! Beside the kernel, the stage as users run it (`lbdem radiograph` on TIFF files, every output
+//! on disk), once with its default map grid (`map_step`: the REV at the centre of every block of
+//! about a sixteenth of the REV side, 11 px at 2048²) and once with maps on every pixel
+//! (`map_step = 1`, 36 MB of maps a 2048² frame, which a disk writing about 640 MB/s with fsync
+//! cannot take at 25 frames/s): both against the kernel alone in the same run (issue 18 item 5).
 
 use super::{BenchArgs, bandwidth, median};
 use anyhow::Result;
@@ -112,20 +118,24 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             let was_quiet = crate::contract::quiet();
             crate::contract::set_quiet(true);
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
-            let stage_fps = pool.install(|| time_stage(&raw, a.reps));
+            let stage_fps = pool.install(|| time_stage(&raw, a.reps, None));
+            let every_px_fps = pool.install(|| time_stage(&raw, a.reps, Some(1)));
             crate::contract::set_quiet(was_quiet);
-            let stage_fps = stage_fps?;
+            let (stage_fps, every_px_fps) = (stage_fps?, every_px_fps?);
             println!(
                 "radiograph stage {n}x{n}, 8 uncompressed u16 TIFF frames -> maps, grid and summary on disk  \
-                 threads={threads}  {stage_fps:.1} frames/s (median of {}) = {:.2} of the kernel alone",
+                 threads={threads}  {stage_fps:.1} frames/s (median of {}) = {:.2} of the kernel alone; \
+                 maps on every pixel (map_step = 1): {every_px_fps:.1} frames/s = {:.2}",
                 a.reps,
-                stage_fps / kernel_fps
+                stage_fps / kernel_fps,
+                every_px_fps / kernel_fps
             );
             results.push(serde_json::json!({
                 "size": n, "threads": threads, "frames_per_s": kernel_fps, "gb_per_s": gbs,
                 "triad_gb_per_s": bw.triad_gbs, "ratio_to_triad": gbs / bw.triad_gbs,
                 "bytes_per_px": BYTES_PER_PX, "stage_frames_per_s": stage_fps,
                 "stage_ratio_to_kernel": stage_fps / kernel_fps, "reps": a.reps,
+                "stage_every_pixel_frames_per_s": every_px_fps,
             }));
         }
     }
@@ -136,9 +146,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
 }
 
 /// Frames per second of `lbdem radiograph` on 8 frames written as TIFF (the two synthetic frames
-/// alternating), from reading them to the last output file, median of `reps`; the frames and
-/// outputs live in a directory of the system's temporary directory, removed afterwards.
-fn time_stage(raw: &[Array2<u16>], reps: usize) -> Result<f64> {
+/// alternating), from reading them to the last output file, median of `reps`, with the default
+/// map grid or `map_step`; the frames and outputs live in a directory of the system's temporary
+/// directory, removed afterwards.
+fn time_stage(raw: &[Array2<u16>], reps: usize, map_step: Option<usize>) -> Result<f64> {
     let dir = std::env::temp_dir().join(format!("lbdem-bench-radiograph-{}", std::process::id()));
     let result = (|| {
         std::fs::create_dir_all(&dir)?;
@@ -170,6 +181,9 @@ fn time_stage(raw: &[Array2<u16>], reps: usize) -> Result<f64> {
         params.insert("d_bar".into(), (30.0 * 6e-6).into());
         params.insert("pixel_size".into(), (6e-6 * 1024.0 / h as f64).into());
         params.insert("plots".into(), false.into());
+        if let Some(k) = map_step {
+            params.insert("map_step".into(), toml::Value::Integer(k as i64));
+        }
         let mut per_frame = Vec::new();
         for r in 0..reps.max(1) {
             let out = dir.join(format!("out{r}"));

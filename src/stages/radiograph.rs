@@ -173,6 +173,12 @@ pub struct Params {
     /// REVs near a bulk phase, flagged in the outputs (on by default).
     #[serde(default)]
     pub edge_flag: EdgeFlag,
+    /// The REV, eps_vol and edge-flag maps hold the REV centred on the middle pixel of every
+    /// `map_step` x `map_step` block (odd, px; 1 = every pixel). Default: the largest odd step
+    /// at most a sixteenth of the REV side (`lbdem_imaging::rev::map_step_auto`; 11 px for a
+    /// 190 px REV), so a 2048² frame writes 0.3 MB of maps instead of 36 MB.
+    #[serde(default)]
+    pub map_step: Option<usize>,
 }
 
 fn three() -> usize {
@@ -236,6 +242,8 @@ pub struct Prepared {
     /// (rows, columns) of every frame.
     pub shape: (usize, usize),
     pub rev_side: usize,
+    /// Pixels between the centres of the maps' cells (`Params::map_step` or its default).
+    pub map_step: usize,
     pub i_l0: f64,
     pub i_s0: f64,
     /// Frame 0's mean corrected intensity over `thickness_roi` (NaN without one).
@@ -421,6 +429,25 @@ fn thickness_and_map(
     Ok((l, map))
 }
 
+/// A rectangle of pixels as the cells of a map of `step` px cells (`dims` cells): the cells whose
+/// centre pixel `k step + step/2` lies inside it, refused if none does.
+fn on_map(roi: Roi, step: usize, dims: (usize, usize)) -> Result<Roi> {
+    let first = |px: usize| (px + step - 1 - step / 2) / step;
+    let span = |from: usize, len: usize, n: usize| {
+        let (a, b) = (first(from).min(n), first(from + len).min(n));
+        (a, b.saturating_sub(a))
+    };
+    let (x, w) = span(roi.x, roi.w, dims.1);
+    let (y, h) = span(roi.y, roi.h, dims.0);
+    if w == 0 || h == 0 {
+        bail!(
+            "the rectangle {:?} (px) holds the centre of no {step} px map cell",
+            <[usize; 4]>::from(roi)
+        );
+    }
+    Ok(Roi::new(x, y, w, h))
+}
+
 fn positive(name: &str, v: f64) -> Result<()> {
     if !(v > 0.0 && v.is_finite()) {
         bail!("parameter '{name}' = {v} must be positive and finite (SI units)");
@@ -542,6 +569,15 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
             shape.0
         );
     }
+    let map_step = p.map_step.unwrap_or_else(|| rev::map_step_auto(rev_side));
+    if map_step == 0 || (map_step > 1 && map_step.is_multiple_of(2)) || map_step > rev_side {
+        bail!(
+            "parameter 'map_step' = {map_step} px: must be odd (each map value is the REV at the \
+             centre pixel of its block), at least 1 and at most the REV side {rev_side} px; \
+             leave it out for the default {}",
+            rev::map_step_auto(rev_side)
+        );
+    }
     let mut rois: Vec<(&str, Roi)> = Vec::new();
     rois.extend(p.open_roi.map(|r| ("open_roi", r)));
     rois.extend(p.i_l0_roi.map(|r| ("i_l0_roi", r)));
@@ -554,6 +590,11 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
     for (name, r) in &rois {
         r.check(name, shape)
             .map_err(|e| anyhow::anyhow!("parameter '{name}': {e}"))?;
+    }
+    for pr in &p.profiles {
+        on_map(pr.roi, map_step, (shape.0 / map_step, shape.1 / map_step)).map_err(|e| {
+            anyhow::anyhow!("profile '{}': {e}; widen its 'roi' or lower 'map_step'", pr.name)
+        })?;
     }
     if let Some(ls) = &p.line_scan {
         if ls.x >= shape.1 || ls.y0 + 3 > ls.y1 || ls.y1 > shape.0 {
@@ -616,6 +657,7 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
         labels: infos.into_iter().map(|i| i.label).collect(),
         shape,
         rev_side,
+        map_step,
         i_l0,
         i_s0,
         troi0,
@@ -852,13 +894,15 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
     };
     let pb = ctx.progress_bar(nf as u64, "radiograph");
     let mut sat = Sat::new();
-    let mut g0_rev = Array2::zeros(shape);
-    let mut g_rev = Array2::zeros(shape);
+    let step = pr.map_step;
+    let mshape = (shape.0 / step, shape.1 / step);
+    let mut g0_rev = Array2::zeros(mshape);
+    let mut g_rev = Array2::zeros(mshape);
     let mut frames_json = Vec::new();
     let mut outs = Vec::new();
     let mut maps = MapWriter::new();
     let mut flagger = pr.bulk.map(|b| edge::Flagger::new(b, pr.rev_side)).transpose()?;
-    let mut eps_buf = Array2::zeros(shape);
+    let mut eps_buf = Array2::zeros(mshape);
     let mut lines = Vec::new();
     for n in 0..nf {
         let fr = frames(n)?;
@@ -888,17 +932,16 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
             }
         }
         let global = sat.area_mean(area)?;
-        // REV map and, for later frames, Eq. (5) in the same pass.
+        // REV map on the map grid and, for later frames, Eq. (5) in the same pass.
         if n == 0 {
-            sat.rev_mean_into(pr.rev_side, p.min_valid, &mut g0_rev)?;
+            sat.rev_grid_into(pr.rev_side, p.min_valid, step, &mut g0_rev, None)?;
         } else {
-            sat.rev_mean_eps_into(
+            sat.rev_grid_into(
                 pr.rev_side,
                 p.min_valid,
-                g0_rev.view(),
-                p.eps_min_gs,
+                step,
                 &mut g_rev,
-                &mut eps_buf,
+                Some((g0_rev.view(), p.eps_min_gs, &mut eps_buf)),
             )?;
         }
         let gs_tiles = sat.tiles(pr.rev_side, p.min_valid)?;
@@ -908,7 +951,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
         if let Some(f) = flagger.as_mut() {
             f.frame(&sat)?;
         }
-        let near_owned = flagger.as_ref().filter(|_| n > 0).map(|f| f.near_u8());
+        let near_owned = flagger.as_ref().filter(|_| n > 0).map(|f| f.near_grid_u8(step));
         let near = near_owned.as_ref();
         let mut eps_json = serde_json::Value::Null;
         let mut eps_away_json = serde_json::Value::Null;
@@ -943,7 +986,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
                         label: "eps_vol (-)",
                         cmap: plot::Colormap::Diverging,
                         range: None,
-                        pixel_size: Some(p.pixel_size),
+                        pixel_size: Some(p.pixel_size * step as f64),
                     },
                     format!(
                         "Volumetric strain eps_vol = g_S.REV^0 / g_S.REV^{n} - 1 (Eq. 5) of frame {n} ({}); \
@@ -966,7 +1009,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
                     label: "g_S (-)",
                     cmap: plot::Colormap::Viridis,
                     range: None,
-                    pixel_size: Some(p.pixel_size),
+                    pixel_size: Some(p.pixel_size * step as f64),
                 },
                 format!(
                     "REV-averaged solid fraction g_S.REV of frame {n} ({}), Eq. ({}), REV side {} px = {:.3} x d_bar.",
@@ -981,9 +1024,12 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
         }
         let mut profs = Vec::new();
         for spec in &p.profiles {
-            let (pos, g) = profile::roi_profile(gmap.view(), spec.roi, spec.axis, "profiles.roi")?;
+            // The ROI's map cells; positions back in pixels (a cell's centre, Sat::rev_grid_into).
+            let roi = on_map(spec.roi, step, mshape)?;
+            let (pos, g) = profile::roi_profile(gmap.view(), roi, spec.axis, "profiles.roi")?;
+            let pos = pos.iter().map(|&k| k * step as f64).collect();
             let e = match eps {
-                Some(e) => Some(profile::roi_profile(e.view(), spec.roi, spec.axis, "profiles.roi")?.1),
+                Some(e) => Some(profile::roi_profile(e.view(), roi, spec.axis, "profiles.roi")?.1),
                 None => None,
             };
             // The flag's share across the ROI: the profile of the ROI's flags alone, over the
@@ -991,13 +1037,13 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
             // neither near an edge nor away from it, so its flag is NaN and left out.
             let f = match (near, eps) {
                 (Some(f), Some(e)) => {
-                    spec.roi.check("profiles.roi", f.dim())?;
-                    let r = spec.roi;
+                    roi.check("profiles.roi", f.dim())?;
+                    let r = roi;
                     let win = s![r.y..r.y + r.h, r.x..r.x + r.w];
                     let sub = Zip::from(f.slice(win))
                         .and(e.slice(win))
                         .map_collect(|&f, &e| if e.is_finite() { f64::from(f) } else { f64::NAN });
-                    let whole = Roi::new(0, 0, spec.roi.w, spec.roi.h);
+                    let whole = Roi::new(0, 0, roi.w, roi.h);
                     Some(profile::roi_profile(sub.view(), whole, spec.axis, "profiles.roi")?.1)
                 }
                 _ => None,
@@ -1029,7 +1075,7 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
         if n == 0 {
             maps.write(gpath, g0_rev.clone())?;
         } else {
-            let (g_next, e_next) = (maps.buffer(shape), maps.buffer(shape));
+            let (g_next, e_next) = (maps.buffer(mshape), maps.buffer(mshape));
             maps.write(gpath, std::mem::replace(&mut g_rev, g_next))?;
             let epath = out.join(format!("eps_vol_{n:03}.tif"));
             maps.write(epath, std::mem::replace(&mut eps_buf, e_next))?;
@@ -1219,6 +1265,9 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
         "image_cols": shape.1,
         "rev_side_px": pr.rev_side,
         "rev_side_m": pr.rev_side as f64 * p.pixel_size,
+        "map_step_px": step,
+        "map_rows": mshape.0,
+        "map_cols": mshape.1,
         "i_l0": pr.i_l0,
         "i_s0": pr.i_s0,
         "mu_s": p.mu_s,

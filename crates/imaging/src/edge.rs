@@ -217,6 +217,17 @@ impl Flagger {
         out
     }
 
+    /// [`Flagger::near_u8`] at the centre pixel of every `step` x `step` block, the grid of
+    /// [`Sat::rev_grid_into`]: element `(i, j)` is the flag of pixel `(i step + step/2,
+    /// j step + step/2)`.
+    pub fn near_grid_u8(&self, step: usize) -> Array2<u8> {
+        let (h, w) = self.dim0.unwrap_or((0, 0));
+        let (k, step) = (self.block, step.max(1));
+        Array2::from_shape_fn((h / step, w / step), |(i, j)| {
+            self.near[[(i * step + step / 2) / k, (j * step + step / 2) / k]]
+        })
+    }
+
     /// Per tile of the non-overlapping REV grid of [`Sat::tiles`]: 1.0 where the tile overlaps
     /// a bulk block of the last frame or the reference (so every tile holding a bulk pixel).
     pub fn tiles(&self) -> Array2<f64> {
@@ -330,6 +341,16 @@ mod tests {
         assert!(extra < 2 * flag.block(), "extra {extra} px");
         assert!((31..100).all(|r| near.row(r).iter().all(|&v| v == 0)));
         assert_eq!(flag.tiles().column(0).to_vec(), vec![1.0, 0.0, 0.0]);
+        // On a map grid, each flag is the full map's at its block's centre pixel.
+        for step in [1, 3, 7] {
+            let g = flag.near_grid_u8(step);
+            assert_eq!(g.dim(), (100 / step, 80 / step));
+            let centre = |i: usize| i * step + step / 2;
+            assert!(
+                g.indexed_iter()
+                    .all(|((i, j), &v)| v == near[[centre(i), centre(j)]])
+            );
+        }
         // A later frame without the band is still flagged where the reference had it.
         let mut g1 = f.clone();
         g1.slice_mut(ndarray::s![..20, ..]).fill(0.3);

@@ -300,6 +300,84 @@ impl Sat {
         Ok(())
     }
 
+    /// The REV mean at one pixel `(r, c)`, with the same arithmetic as [`Sat::rev_row`] gives
+    /// that pixel (an unclipped window of an unmasked table: sum times the inverse count;
+    /// otherwise the window's finite mean), so a map sampled on a grid holds the full map's bits.
+    #[inline]
+    fn rev_at(&self, r: usize, c: usize, side: usize, need: usize) -> f64 {
+        let (h, w) = self.dim();
+        let lo = side / 2;
+        let hi = side - lo;
+        let (r0, r1) = (r.saturating_sub(lo), (r + hi).min(h));
+        let interior = c >= lo && c + hi <= w;
+        let n = (r1 - r0) * side;
+        if self.count.is_none() && interior && n >= need {
+            let (s, _) = self.window(r0, c - lo, r1, c + hi);
+            return s * (1.0 / n as f64);
+        }
+        let (s, n) = self.window(r0, c.saturating_sub(lo), r1, (c + hi).min(w));
+        if n >= need { s / n as f64 } else { f64::NAN }
+    }
+
+    /// The REV map sampled at the centre pixel of every `step` x `step` block: element `(i, j)`
+    /// is the full map's pixel `(i step + step/2, j step + step/2)`, bit for bit, and the map is
+    /// `h / step` x `w / step` (a remainder strip narrower than a block is left out). An REV
+    /// map is a window mean `side` px across, so a step well under the side loses nothing the
+    /// window resolves, and the work and bytes fall by `step²` (issue 18 item 5). `eps` with
+    /// `g0` (the reference map on the same grid) also fills Eq. (5), NaN where `g0 < min_gs`.
+    pub fn rev_grid_into(
+        &self,
+        side: usize,
+        min_valid: f64,
+        step: usize,
+        out: &mut Array2<f64>,
+        eps: Option<(ArrayView2<f64>, f64, &mut Array2<f64>)>,
+    ) -> Result<()> {
+        let (h, w) = self.dim();
+        check_side(side, h, w)?;
+        if step == 0 || step > h || step > w {
+            return Err(ImagingError::invalid(
+                "map_step",
+                step,
+                "must be at least 1 px and at most the image side",
+            ));
+        }
+        let dims = (h / step, w / step);
+        if out.dim() != dims || !out.is_standard_layout() {
+            *out = Array2::zeros(dims);
+        }
+        let need = (min_valid * (side * side) as f64).ceil().max(1.0) as usize;
+        let at = |i: usize| i * step + step / 2;
+        out.axis_iter_mut(Axis(0))
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(i, mut orow)| {
+                for (j, o) in orow.iter_mut().enumerate() {
+                    *o = self.rev_at(at(i), at(j), side, need);
+                }
+            });
+        if let Some((g0, min_gs, e)) = eps {
+            if g0.dim() != dims {
+                return Err(ImagingError::invalid(
+                    "g0",
+                    format!("{:?}", g0.dim()),
+                    "must match the map grid",
+                ));
+            }
+            if e.dim() != dims || !e.is_standard_layout() {
+                *e = Array2::zeros(dims);
+            }
+            Zip::from(e).and(&*out).and(&g0).par_for_each(|e, &g, &a| {
+                *e = if a >= min_gs {
+                    crate::beer_lambert::eps_vol(a, g)
+                } else {
+                    f64::NAN
+                };
+            });
+        }
+        Ok(())
+    }
+
     pub fn rev_mean(&self, side: usize, min_valid: f64) -> Result<Array2<f64>> {
         let mut out = Array2::zeros(self.dim());
         self.rev_mean_into(side, min_valid, &mut out)?;
@@ -347,6 +425,15 @@ pub fn rev_side_px(rev_factor: f64, d_bar: f64, pixel_size: f64) -> Result<usize
         }
     }
     Ok(((rev_factor * d_bar / pixel_size).round() as usize).max(1))
+}
+
+/// The default step of the REV maps' grid ([`Sat::rev_grid_into`]): the largest odd number of
+/// pixels at most a sixteenth of the REV side, at least 1. Odd, so each value sits at the centre
+/// pixel of its block; a sixteenth, so an REV spans 16 map cells and a profile or a field figure
+/// loses nothing the window resolves (`docs/radiograph.md`, "Outputs").
+pub fn map_step_auto(rev_side: usize) -> usize {
+    let s = (rev_side / 16).max(1);
+    if s.is_multiple_of(2) { s - 1 } else { s }
 }
 
 /// Naive O(side^2) reference of [`Sat::rev_mean`], for tests.
@@ -447,6 +534,46 @@ mod tests {
         let e_ref = crate::beer_lambert::eps_vol_field(g0.view(), g1.view(), 0.1);
         assert!(g.iter().zip(&g1).all(|(a, b)| a.to_bits() == b.to_bits()));
         assert!(e.iter().zip(&e_ref).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
+    fn a_map_on_a_grid_holds_the_full_maps_bits_at_its_block_centres() {
+        let f = Array2::from_shape_fn((47, 301), |(r, c)| ((r * 5 + c * 11) % 23) as f64 * 0.07);
+        let mut masked = f.clone();
+        masked[[20, 150]] = f64::NAN;
+        for field in [&f, &masked] {
+            let mut sat = Sat::new();
+            sat.build(field.view());
+            for (side, step) in [(9, 1), (9, 3), (12, 5), (41, 7)] {
+                let full = sat.rev_mean(side, 0.5).unwrap();
+                let e0 = full.mapv(|v| v * 0.9 + 0.05);
+                let mut g = Array2::zeros((0, 0));
+                let mut g0 = Array2::zeros((0, 0));
+                let mut e = Array2::zeros((0, 0));
+                sat.rev_grid_into(side, 0.5, step, &mut g0, None).unwrap();
+                let g0 = g0.mapv(|v| v * 0.9 + 0.05);
+                sat.rev_grid_into(side, 0.5, step, &mut g, Some((g0.view(), 0.1, &mut e)))
+                    .unwrap();
+                assert_eq!(g.dim(), (47 / step, 301 / step));
+                let e_full = crate::beer_lambert::eps_vol_field(e0.view(), full.view(), 0.1);
+                for ((i, j), v) in g.indexed_iter() {
+                    let (r, c) = (i * step + step / 2, j * step + step / 2);
+                    let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+                    assert!(
+                        same(*v, full[[r, c]]),
+                        "side {side} step {step} ({r}, {c}): {v} vs {}",
+                        full[[r, c]]
+                    );
+                    assert!(same(e[[i, j]], e_full[[r, c]]), "eps at ({r}, {c})");
+                }
+            }
+        }
+        let mut sat = Sat::new();
+        sat.build(f.view());
+        let mut g = Array2::zeros((0, 0));
+        assert!(sat.rev_grid_into(9, 0.5, 0, &mut g, None).is_err());
+        let auto: Vec<usize> = [1, 31, 32, 47, 48, 64, 95, 190].map(map_step_auto).to_vec();
+        assert_eq!(auto, [1, 1, 1, 1, 3, 3, 5, 11]);
     }
 
     #[test]

@@ -152,13 +152,17 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     // The radiograph's pixel grid in d̄ of the experiment, origin at the middle of the plate face.
     let first = tio::read_pages(&rs.dir.join("eps_vol_001.tif"))
         .with_context(|| format!("radiograph stage {}: its eps_vol maps", rs.dir.display()))?;
+    // Map cell (r, c) holds the REV centred on pixel (r k + k/2, c k + k/2), k = map_step (odd):
+    // the centre of the k x k block of pixels it stands for, so the grid's cells are the blocks.
     let (h, w) = first[0].data.dim();
+    let k = rs.map_step;
+    let (h_px, w_px) = if rs.image.0 > 0 { rs.image } else { (h * k, w * k) };
     let s = rs.pixel_size / d_exp;
     let mid = 0.5 * (plate_px[0] + plate_px[1]);
     let grid = Grid {
         x0: -mid * s,
-        y0: (plate_px[2] - h as f64) * s,
-        dx: s,
+        y0: (plate_px[2] - (h * k) as f64) * s,
+        dx: s * k as f64,
         nx: w,
         ny: h,
     };
@@ -170,17 +174,19 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
                 .map(|a| a.iter().filter_map(|x| x.as_u64().map(|v| v as usize)).collect())
                 .unwrap_or_default();
             match rows.as_slice() {
-                [r0, r1] if r1 > r0 => [0, *r0, w, r1 - r0],
-                _ => [0, 0, w, h],
+                [r0, r1] if r1 > r0 => [0, *r0, w_px, r1 - r0],
+                _ => [0, 0, w_px, h_px],
             }
         }
-        (None, None) => [0, 0, w, h],
+        (None, None) => [0, 0, w_px, h_px],
     };
-    if fov_px[2] == 0 || fov_px[3] == 0 || fov_px[0] + fov_px[2] > w || fov_px[1] + fov_px[3] > h {
-        bail!("fov_px = {fov_px:?} is empty or outside the {w} x {h} radiographs");
+    if fov_px[2] == 0 || fov_px[3] == 0 || fov_px[0] + fov_px[2] > w_px || fov_px[1] + fov_px[3] > h_px {
+        bail!("fov_px = {fov_px:?} is empty or outside the {w_px} x {h_px} radiographs");
     }
+    // A map cell is in the field of view when its centre pixel is.
     let in_fov = |a: &mut Array2<f64>| {
         for ((r, c), v) in a.indexed_iter_mut() {
+            let (r, c) = (r * k + k / 2, c * k + k / 2);
             if c < fov_px[0] || c >= fov_px[0] + fov_px[2] || r < fov_px[1] || r >= fov_px[1] + fov_px[3] {
                 *v = f64::NAN;
             }
@@ -189,12 +195,14 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     let frame = frame_of(&run, &reference_grains, d_run);
     let opts = StrainOptions {
         max_edge_d: p.max_edge_d,
-        pixels_per_d: 1.0 / s,
+        pixels_per_d: 1.0 / (s * k as f64),
         rev_factor: rs.rev_factor,
         min_valid: rs.min_valid,
         ..Default::default()
     };
     let setup = Setup::on_grid(&reference_grains, frame, grid, &opts)?;
+    // The true Eq. 5 is formed on the pixels, with the radiograph stage's REV side.
+    let rev_side_px = lbdem_analysis::raster::rev_side(rs.rev_factor, 1.0, s)?;
     let pairs: Vec<[u64; 2]> = match (&p.pairs, &rs.fov) {
         (Some(v), _) => v.clone(),
         (None, Some(f)) => f["frames"]
@@ -255,7 +263,7 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         let (_, blue_x) = roi_profile(&xip, &setup.grid, p.blue_roi, false);
         let (_, blue_t) = roi_profile(&f.eps_vol, &setup.grid, p.blue_roi, false);
         let e_dem = eq18(&run, &reference_grains, &g, u).map_or(f64::NAN, |v| v.1);
-        let truth = true_eq5(&rs, fr, setup.rev_side)?.map(|mut t| {
+        let truth = true_eq5(&rs, fr, rev_side_px)?.map(|mut t| {
             in_fov(&mut t);
             t
         });
@@ -344,8 +352,11 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         "d_bar_radiograph_m": d_exp,
         "d_bar_run_m": d_run,
         "pixel_d": s,
+        "map_step_px": k,
+        "cell_d": setup.grid.dx,
         "fov_px": fov_px,
-        "rev_side_px": setup.rev_side,
+        "rev_side_px": rev_side_px,
+        "rev_side_cells": setup.rev_side,
         "pairs": pairs.len(),
         "last": {
             "frame": fr, "step": st, "u_y_d": ud,

@@ -15,6 +15,10 @@ pub(super) struct RadiographSide {
     pub(super) rev_factor: f64,
     pub(super) min_valid: f64,
     pub(super) frames: usize,
+    /// Pixels between the centres of the maps' cells (1 for runs from before the map grid).
+    pub(super) map_step: usize,
+    /// Frame size (rows, columns), px.
+    pub(super) image: (usize, usize),
     /// `fov.json` beside the frames (written by `synth-run`) and its directory.
     pub(super) fov: Option<serde_json::Value>,
     pub(super) fov_dir: Option<PathBuf>,
@@ -70,6 +74,11 @@ pub(super) fn radiograph_side(dir: &Path) -> Result<RadiographSide> {
         rev_factor: num("rev_factor")?,
         min_valid: num("min_valid")?,
         frames,
+        map_step: rec.output.summary["map_step_px"].as_u64().unwrap_or(1).max(1) as usize,
+        image: (
+            rec.output.summary["image_rows"].as_u64().unwrap_or(0) as usize,
+            rec.output.summary["image_cols"].as_u64().unwrap_or(0) as usize,
+        ),
         fov,
         fov_dir: fov_path.and_then(|p| p.parent().map(Path::to_path_buf)),
         eps_min_gs: num("eps_min_gs")?,
@@ -77,7 +86,8 @@ pub(super) fn radiograph_side(dir: &Path) -> Result<RadiographSide> {
 }
 
 /// Eq. 5 on the true pixel solid fraction `synth-run` wrote for frame `fr` (REV of `side` px as
-/// the radiograph stage), or `None` for frames that do not come from `synth-run`.
+/// the radiograph stage), on the stage's map grid (the centre pixel of every `map_step` block),
+/// or `None` for frames that do not come from `synth-run`.
 pub(super) fn true_eq5(rs: &RadiographSide, fr: u64, side: usize) -> Result<Option<Array2<f64>>> {
     let Some(dir) = &rs.fov_dir else {
         return Ok(None);
@@ -91,9 +101,10 @@ pub(super) fn true_eq5(rs: &RadiographSide, fr: u64, side: usize) -> Result<Opti
     }
     let g0 = lbdem_analysis::raster::rev_mean(&tio::read_pages(&p0)?.remove(0).data, side, rs.min_valid)?;
     let gn = lbdem_analysis::raster::rev_mean(&tio::read_pages(&pn)?.remove(0).data, side, rs.min_valid)?;
-    Ok(Some(lbdem_imaging::beer_lambert::eps_vol_field(
-        g0.view(),
-        gn.view(),
-        rs.eps_min_gs,
-    )))
+    let eps = lbdem_imaging::beer_lambert::eps_vol_field(g0.view(), gn.view(), rs.eps_min_gs);
+    let k = rs.map_step;
+    let (h, w) = eps.dim();
+    Ok(Some(Array2::from_shape_fn((h / k, w / k), |(i, j)| {
+        eps[[i * k + k / 2, j * k + k / 2]]
+    })))
 }
