@@ -279,7 +279,7 @@ fn intensity_and_triangulation_measure_a_known_affine_strain() {
         c["rms_xip_minus_true"], a["rms_xip_minus_true"]
     );
     // Measured: +2.2e-5 and +4.5e-5; the RMS of XIP - true 7.969e-3 against 7.926e-3 (0.54 %).
-    assert!(dx.abs() < 1e-4 && dt.abs() < 1e-4, "{c:?}");
+    assert!(dx.abs() < 5e-5 && dt.abs() < 1e-4, "{c:?}");
     assert!(
         (c["rms_xip_minus_true"] / a["rms_xip_minus_true"] - 1.0).abs() < 0.011,
         "{c:?}"

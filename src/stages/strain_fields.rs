@@ -157,9 +157,10 @@ impl Setup {
         let rev_side = raster::rev_side(o.rev_factor, 1.0, grid.dx)?;
         if rev_side > grid.nx.min(grid.ny) {
             bail!(
-                "the REV ({} d̄ = {rev_side} px) is larger than the field of view ({} x {} px = {:.1} x {:.1} d̄); \
-                 widen 'fov' or lower 'rev_factor'",
+                "the REV ({} d̄ = {rev_side} cells of {:.3} d̄) is larger than the field of view ({} x {} cells = \
+                 {:.1} x {:.1} d̄); widen 'fov' or lower 'rev_factor'",
                 o.rev_factor,
+                grid.dx,
                 grid.nx,
                 grid.ny,
                 grid.nx as f64 * grid.dx,

@@ -430,7 +430,7 @@ pub fn rev_side_px(rev_factor: f64, d_bar: f64, pixel_size: f64) -> Result<usize
 /// The default step of the REV maps' grid ([`Sat::rev_grid_into`]): the largest odd number of
 /// pixels at most a sixteenth of the REV side, at least 1. Odd, so each value sits at the centre
 /// pixel of its block; a sixteenth, so an REV spans 16 map cells and a profile or a field figure
-/// loses nothing the window resolves (`docs/radiograph.md`, "Outputs").
+/// loses nothing the window resolves (`docs/radiograph.md`, "The map grid").
 pub fn map_step_auto(rev_side: usize) -> usize {
     let s = (rev_side / 16).max(1);
     if s.is_multiple_of(2) { s - 1 } else { s }

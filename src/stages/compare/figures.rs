@@ -141,7 +141,7 @@ pub(super) fn maps(
         y_label: "y (d_bar)",
         mark_label: None,
     };
-    // XIP beside TRI on one colour scale, over the pixels where both are defined.
+    // XIP beside TRI on one colour scale, over the cells (pixels at map_step 1) where both are defined.
     let both = |a: &Array2<f64>, b: &Array2<f64>| {
         let mut a = a.clone();
         a.zip_mut_with(b, |x, y| {
@@ -269,7 +269,7 @@ pub(super) fn agreement_outputs(
             ("rms_profile_blue", Col::F64(&a.rms_blue)),
             ("eps_vol_dem", Col::F64(&a.eps_dem)),
             ("net_signs_agree", Col::U64(&a.same_sign)),
-            ("overlap_px", Col::U64(&a.overlap)),
+            ("overlap_cells", Col::U64(&a.overlap)),
             ("mean_eps_vol_true", Col::F64(&a.mean_true)),
             ("rms_xip_minus_true", Col::F64(&a.rms_xip_true)),
             ("rms_true_minus_area_strain", Col::F64(&a.rms_true_area)),
@@ -279,7 +279,8 @@ pub(super) fn agreement_outputs(
     tables.push(Table {
         path: "agreement.csv".into(),
         caption: format!(
-            "Agreement of every frame-snapshot pair over the pixels both sides cover: means of XIP ε_vol, TRI ε_xx + ε_yy \
+            "Agreement of every frame-snapshot pair over the map cells both sides cover (overlap_cells; the radiograph \
+             stage's pixels at map_step 1): means of XIP ε_vol, TRI ε_xx + ε_yy \
              and TRI J − 1, RMS of XIP − TRI and XIP − (J − 1), their correlation, RMS of the red and blue profile \
              differences, ε_vol^DEM (Eq. 18) and whether the mean XIP and ε_vol^DEM have the same sign; with frames from \
              synth-run, also Eq. 5 on the true solid fraction (no blur, no noise) and its RMS differences from XIP and \

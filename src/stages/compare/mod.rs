@@ -4,7 +4,8 @@
 //! The experiment side is the output of a `radiograph` stage (any stack it reads: real beamtime
 //! frames, `synth-radiograph`, or `synth-run` renderings of a run): its ε_vol maps (Eq. 5, XIP).
 //! The simulation side is the run's strain by triangulation (TRI) painted on the radiograph's
-//! own pixel grid and averaged by the same √10 d̄ REV. Both are aligned on the push-plate: x, y in
+//! own map grid (its pixels, or its `map_step` cells) and averaged by the √10 d̄ REV rounded to
+//! whole cells (`rev_side_tri_px` in `comparison.json`: within half a cell of the radiograph's). Both are aligned on the push-plate: x, y in
 //! mean grain diameters of each side from the middle of the plate's face before it moves
 //! (`plate_px` gives the face in the radiograph: its corners' columns and its row; `synth-run`
 //! writes it in `fov.json`, which is read when `plate_px` is not given).
@@ -156,6 +157,15 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     // the centre of the k x k block of pixels it stands for, so the grid's cells are the blocks.
     let (h, w) = first[0].data.dim();
     let k = rs.map_step;
+    if k.is_multiple_of(2) && k > 1 || (rs.image.0 > 0 && (h, w) != (rs.image.0 / k, rs.image.1 / k)) {
+        bail!(
+            "radiograph stage {}: eps_vol_001.tif is {h} x {w} cells, but its summary gives {} x {} px frames \
+             and map_step_px = {k} (odd, frames / step cells expected): rerun the radiograph stage",
+            rs.dir.display(),
+            rs.image.0,
+            rs.image.1
+        );
+    }
     let (h_px, w_px) = if rs.image.0 > 0 { rs.image } else { (h * k, w * k) };
     let s = rs.pixel_size / d_exp;
     let mid = 0.5 * (plate_px[0] + plate_px[1]);
@@ -202,7 +212,10 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     };
     let setup = Setup::on_grid(&reference_grains, frame, grid, &opts)?;
     // The true Eq. 5 is formed on the pixels, with the radiograph stage's REV side.
-    let rev_side_px = lbdem_analysis::raster::rev_side(rs.rev_factor, 1.0, s)?;
+    let rev_side_px = match rs.rev_side_px {
+        Some(v) => v,
+        None => lbdem_analysis::raster::rev_side(rs.rev_factor, 1.0, s)?,
+    };
     let pairs: Vec<[u64; 2]> = match (&p.pairs, &rs.fov) {
         (Some(v), _) => v.clone(),
         (None, Some(f)) => f["frames"]
@@ -357,6 +370,7 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         "fov_px": fov_px,
         "rev_side_px": rev_side_px,
         "rev_side_cells": setup.rev_side,
+        "rev_side_tri_px": setup.rev_side * k,
         "pairs": pairs.len(),
         "last": {
             "frame": fr, "step": st, "u_y_d": ud,
@@ -368,7 +382,7 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
             "eps_vol_dem": agg.eps_dem[lastk],
             "experiment_net": exp_net,
             "net_signs_agree": agg.same_sign[lastk] == 1,
-            "overlap_px": agg.overlap[lastk],
+            "overlap_cells": agg.overlap[lastk],
             "mean_eps_vol_true_eq5": agg.mean_true[lastk],
             "rms_xip_minus_true_eq5": agg.rms_xip_true[lastk],
             "rms_true_eq5_minus_area_strain": agg.rms_true_area[lastk],

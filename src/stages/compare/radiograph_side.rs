@@ -19,6 +19,8 @@ pub(super) struct RadiographSide {
     pub(super) map_step: usize,
     /// Frame size (rows, columns), px.
     pub(super) image: (usize, usize),
+    /// The stage's REV side, px (absent in manifests from before it was recorded).
+    pub(super) rev_side_px: Option<usize>,
     /// `fov.json` beside the frames (written by `synth-run`) and its directory.
     pub(super) fov: Option<serde_json::Value>,
     pub(super) fov_dir: Option<PathBuf>,
@@ -79,6 +81,7 @@ pub(super) fn radiograph_side(dir: &Path) -> Result<RadiographSide> {
             rec.output.summary["image_rows"].as_u64().unwrap_or(0) as usize,
             rec.output.summary["image_cols"].as_u64().unwrap_or(0) as usize,
         ),
+        rev_side_px: rec.output.summary["rev_side_px"].as_u64().map(|v| v as usize),
         fov,
         fov_dir: fov_path.and_then(|p| p.parent().map(Path::to_path_buf)),
         eps_min_gs: num("eps_min_gs")?,
