@@ -5,10 +5,11 @@
 //! frames, `synth-radiograph`, or `synth-run` renderings of a run): its ε_vol maps (Eq. 5, XIP).
 //! The simulation side is the run's strain by triangulation (TRI) painted on the radiograph's
 //! own map grid (its pixels, or its `map_step` cells) and averaged by the √10 d̄ REV rounded to
-//! whole cells (`rev_side_tri_px` in `comparison.json`: within half a cell of the radiograph's). Both are aligned on the push-plate: x, y in
-//! mean grain diameters of each side from the middle of the plate's face before it moves
-//! (`plate_px` gives the face in the radiograph: its corners' columns and its row; `synth-run`
-//! writes it in `fov.json`, which is read when `plate_px` is not given).
+//! whole cells (`rev_side_tri_px` in `comparison.json`: within half a cell of the radiograph's).
+//! Both are aligned on the push-plate: x, y in mean grain diameters of each side from the middle
+//! of the plate's face before it moves (`plate_px` gives the face in the radiograph: its
+//! corners' columns and its row; `synth-run` writes it in `fov.json`, which is read when
+//! `plate_px` is not given).
 //!
 //! Out: Fig. 6-style profiles (red ROI averaged along y, blue ROI along x), Figs. 8-10-style
 //! panels (ε_vol XIP and TRI on one colour scale, ε_xy, Δp with Δp < Δp_c marked), the
