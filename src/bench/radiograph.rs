@@ -60,12 +60,19 @@ fn roi_mean(f: &Array2<u16>, r: Roi) -> f64 {
     v.iter().map(|&c| c as f64).sum::<f64>() / v.len() as f64
 }
 
-/// Seconds per frame (median of `reps`), on a pool of `threads`.
-fn time_frames(threads: usize, raw: &[Array2<u16>], reps: usize) -> Result<f64> {
+/// The REV side (px) of the synthetic frames of `n` rows: sqrt(10) d_bar, d_bar = 30 px at 1024
+/// rows (the stage's `rev_side_px` with the parameters of [`time_stage`]).
+fn rev_side(n: usize) -> usize {
+    (10f64.sqrt() * 30.0 * n as f64 / 1024.0).round() as usize
+}
+
+/// Seconds per frame (median of `reps`), on a pool of `threads`: the REV and Eq. 5 maps on every
+/// pixel (`grid` None) or on the stage's default grid of cells (`grid` Some(step)).
+fn time_frames(threads: usize, raw: &[Array2<u16>], reps: usize, grid: Option<usize>) -> Result<f64> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
     pool.install(|| {
         let (h, w) = raw[0].dim();
-        let side = (10f64.sqrt() * 30.0 * h as f64 / 1024.0).round() as usize;
+        let side = rev_side(h);
         let (mu_s, mu_l, l0) = (2147.85, 10120.559, 150e-6);
         let liquid = Roi::new(16, h - h / 32, w - 32, h / 32 - 2);
         let solid_like = Roi::new(16, 2, w - 32, h / 32 - 2);
@@ -75,7 +82,10 @@ fn time_frames(threads: usize, raw: &[Array2<u16>], reps: usize) -> Result<f64> 
         let mut gn = Array2::zeros((h, w));
         let mut eps = Array2::zeros((h, w));
         sat.build_u16(raw[0].view(), &FractionMap::eq1(i_l0, i_s0)?.lut_u16());
-        sat.rev_mean_into(side, 0.5, &mut g0)?;
+        match grid {
+            None => sat.rev_mean_into(side, 0.5, &mut g0)?,
+            Some(k) => sat.rev_grid_into(side, 0.5, k, &mut g0, None)?,
+        }
         let mut per_frame = Vec::new();
         for _ in 0..reps.max(1) {
             let frames = 4;
@@ -85,7 +95,10 @@ fn time_frames(threads: usize, raw: &[Array2<u16>], reps: usize) -> Result<f64> 
                 let ln_ = bl::thickness_eq2(l0, mu_s, mu_l, i_l0, roi_mean(f, liquid), 0.0, 0.0);
                 let map = FractionMap::eq4(i_l0, mu_s, mu_l, l0, ln_)?;
                 sat.build_u16(f.view(), &map.lut_u16());
-                sat.rev_mean_eps_into(side, 0.5, g0.view(), 0.1, &mut gn, &mut eps)?;
+                match grid {
+                    None => sat.rev_mean_eps_into(side, 0.5, g0.view(), 0.1, &mut gn, &mut eps)?,
+                    Some(k) => sat.rev_grid_into(side, 0.5, k, &mut gn, Some((g0.view(), 0.1, &mut eps)))?,
+                }
             }
             per_frame.push(t.elapsed().as_secs_f64() / frames as f64);
             std::hint::black_box(&eps);
@@ -104,7 +117,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         let raw = frames(n)?;
         for threads in [1, 2] {
             let bw = bandwidth::measure(threads, bandwidth::default_len(a.quick), a.reps)?;
-            let kernel_fps = 1.0 / time_frames(threads, &raw, a.reps)?;
+            let kernel_fps = 1.0 / time_frames(threads, &raw, a.reps, None)?;
             let gbs = BYTES_PER_PX * (n * n) as f64 * kernel_fps / 1e9;
             println!(
                 "radiograph {n}x{n} u16 -> REV g_S + eps_vol  threads={threads}  {kernel_fps:.1} frames/s (median of {})  \
@@ -122,6 +135,15 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             let every_px_fps = pool.install(|| time_stage(&raw, a.reps, Some(1)));
             crate::contract::set_quiet(was_quiet);
             let (stage_fps, every_px_fps) = (stage_fps?, every_px_fps?);
+            // The kernel as the stage runs it by default: the maps on the grid of cells.
+            let step = lbdem_imaging::rev::map_step_auto(rev_side(n));
+            let grid_fps = 1.0 / time_frames(threads, &raw, a.reps, Some(step))?;
+            println!(
+                "radiograph {n}x{n} u16 -> REV g_S + eps_vol on the {step} px grid of cells  threads={threads}  \
+                 {grid_fps:.1} frames/s (median of {}): the stage runs at {:.2} of it",
+                a.reps,
+                stage_fps / grid_fps
+            );
             println!(
                 "radiograph stage {n}x{n}, 8 uncompressed u16 TIFF frames -> maps, grid and summary on disk  \
                  threads={threads}  {stage_fps:.1} frames/s (median of {}) = {:.2} of the kernel alone; \
@@ -136,6 +158,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 "bytes_per_px": BYTES_PER_PX, "stage_frames_per_s": stage_fps,
                 "stage_ratio_to_kernel": stage_fps / kernel_fps, "reps": a.reps,
                 "stage_every_pixel_frames_per_s": every_px_fps,
+                "grid_kernel_frames_per_s": grid_fps, "map_step": step,
+                "stage_ratio_to_grid_kernel": stage_fps / grid_fps,
             }));
         }
     }
