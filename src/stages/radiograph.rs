@@ -244,6 +244,8 @@ pub struct Prepared {
     pub rev_side: usize,
     /// Pixels between the centres of the maps' cells (`Params::map_step` or its default).
     pub map_step: usize,
+    /// Each profile's ROI as cells of the maps, in `Params::profiles` order.
+    profile_cells: Vec<Roi>,
     pub i_l0: f64,
     pub i_s0: f64,
     /// Frame 0's mean corrected intensity over `thickness_roi` (NaN without one).
@@ -591,11 +593,15 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
         r.check(name, shape)
             .map_err(|e| anyhow::anyhow!("parameter '{name}': {e}"))?;
     }
-    for pr in &p.profiles {
-        on_map(pr.roi, map_step, (shape.0 / map_step, shape.1 / map_step)).map_err(|e| {
-            anyhow::anyhow!("profile '{}': {e}; widen its 'roi' or lower 'map_step'", pr.name)
-        })?;
-    }
+    let profile_cells = p
+        .profiles
+        .iter()
+        .map(|pr| {
+            on_map(pr.roi, map_step, (shape.0 / map_step, shape.1 / map_step)).map_err(|e| {
+                anyhow::anyhow!("profile '{}': {e}; widen its 'roi' or lower 'map_step'", pr.name)
+            })
+        })
+        .collect::<Result<Vec<Roi>>>()?;
     if let Some(ls) = &p.line_scan {
         if ls.x >= shape.1 || ls.y0 + 3 > ls.y1 || ls.y1 > shape.0 {
             bail!(
@@ -658,6 +664,7 @@ pub fn prepare(p: &Params, ctx: &StageContext) -> Result<Prepared> {
         shape,
         rev_side,
         map_step,
+        profile_cells,
         i_l0,
         i_s0,
         troi0,
@@ -1023,9 +1030,8 @@ fn write_outputs(p: &Params, ctx: &StageContext, pr: Prepared) -> Result<StageOu
             )?;
         }
         let mut profs = Vec::new();
-        for spec in &p.profiles {
+        for (spec, &roi) in p.profiles.iter().zip(&pr.profile_cells) {
             // The ROI's map cells; positions back in pixels (a cell's centre, Sat::rev_grid_into).
-            let roi = on_map(spec.roi, step, mshape)?;
             let (pos, g) = profile::roi_profile(gmap.view(), roi, spec.axis, "profiles.roi")?;
             let pos = pos.iter().map(|&k| k * step as f64).collect();
             let e = match eps {

@@ -15,7 +15,7 @@
 //! phases (a disk fills at most pi/4 of its bounding square; a liquid pocket of one grain is
 //! averaged with its neighbours), so only regions larger than the window are bulk.
 
-use crate::rev::Sat;
+use crate::rev::{Sat, cell_centre};
 use crate::{ImagingError, Result};
 use ndarray::{Array2, Axis};
 use rayon::prelude::*;
@@ -224,7 +224,7 @@ impl Flagger {
         let (h, w) = self.dim0.unwrap_or((0, 0));
         let (k, step) = (self.block, step.max(1));
         Array2::from_shape_fn((h / step, w / step), |(i, j)| {
-            self.near[[(i * step + step / 2) / k, (j * step + step / 2) / k]]
+            self.near[[cell_centre(i, step) / k, cell_centre(j, step) / k]]
         })
     }
 

@@ -347,13 +347,12 @@ impl Sat {
             *out = Array2::zeros(dims);
         }
         let need = (min_valid * (side * side) as f64).ceil().max(1.0) as usize;
-        let at = |i: usize| i * step + step / 2;
         out.axis_iter_mut(Axis(0))
             .into_par_iter()
             .enumerate()
             .for_each(|(i, mut orow)| {
                 for (j, o) in orow.iter_mut().enumerate() {
-                    *o = self.rev_at(at(i), at(j), side, need);
+                    *o = self.rev_at(cell_centre(i, step), cell_centre(j, step), side, need);
                 }
             });
         if let Some((g0, min_gs, e)) = eps {
@@ -364,16 +363,10 @@ impl Sat {
                     "must match the map grid",
                 ));
             }
-            if e.dim() != dims || !e.is_standard_layout() {
+            if e.dim() != dims {
                 *e = Array2::zeros(dims);
             }
-            Zip::from(e).and(&*out).and(&g0).par_for_each(|e, &g, &a| {
-                *e = if a >= min_gs {
-                    crate::beer_lambert::eps_vol(a, g)
-                } else {
-                    f64::NAN
-                };
-            });
+            crate::beer_lambert::eps_vol_into(g0, out.view(), min_gs, e);
         }
         Ok(())
     }
@@ -425,6 +418,13 @@ pub fn rev_side_px(rev_factor: f64, d_bar: f64, pixel_size: f64) -> Result<usize
         }
     }
     Ok(((rev_factor * d_bar / pixel_size).round() as usize).max(1))
+}
+
+/// The pixel (row or column) at the centre of cell `i` of a grid of `step` px cells (`step` odd):
+/// where [`Sat::rev_grid_into`] evaluates the REV and every reader of such a map places it.
+#[inline]
+pub fn cell_centre(i: usize, step: usize) -> usize {
+    i * step + step / 2
 }
 
 /// The default step of the REV maps' grid ([`Sat::rev_grid_into`]): the largest odd number of

@@ -23,6 +23,7 @@ use crate::contract::{Stage, StageContext, StageOutput};
 use crate::io::tiff as tio;
 use anyhow::{Context, Result, bail};
 use lbdem_analysis::raster::Grid;
+use lbdem_imaging::rev::cell_centre;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -197,7 +198,7 @@ fn compare(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     // A map cell is in the field of view when its centre pixel is.
     let in_fov = |a: &mut Array2<f64>| {
         for ((r, c), v) in a.indexed_iter_mut() {
-            let (r, c) = (r * k + k / 2, c * k + k / 2);
+            let (r, c) = (cell_centre(r, k), cell_centre(c, k));
             if c < fov_px[0] || c >= fov_px[0] + fov_px[2] || r < fov_px[1] || r >= fov_px[1] + fov_px[3] {
                 *v = f64::NAN;
             }

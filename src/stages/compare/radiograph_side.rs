@@ -4,6 +4,7 @@
 use crate::contract::{MANIFEST, StageRecord};
 use crate::io::tiff as tio;
 use anyhow::{Context, Result, bail};
+use lbdem_imaging::rev::cell_centre;
 use ndarray::Array2;
 use std::path::{Path, PathBuf};
 
@@ -108,6 +109,6 @@ pub(super) fn true_eq5(rs: &RadiographSide, fr: u64, side: usize) -> Result<Opti
     let k = rs.map_step;
     let (h, w) = eps.dim();
     Ok(Some(Array2::from_shape_fn((h / k, w / k), |(i, j)| {
-        eps[[i * k + k / 2, j * k + k / 2]]
+        eps[[cell_centre(i, k), cell_centre(j, k)]]
     })))
 }
