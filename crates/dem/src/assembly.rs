@@ -503,6 +503,7 @@ mod tests {
             sigma_c: 1.0,
             cohesion: 1.0,
             lambda: 0.5,
+            damping: 0.0,
         };
         install_membrane(
             &mut s,

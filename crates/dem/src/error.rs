@@ -36,6 +36,21 @@ pub enum DemError {
         k_wall: f64,
         c_wall: f64,
     },
+    #[error(
+        "the membrane bonds' dashpots ([bonds] params.damping) are too stiff for the time step dt = \
+         {dt:e} s: at body {body} their decay rate times the step is {number:.3}, above {limit} \
+         (past it the explicit dashpots overshoot and the grains blow up within a few steps; \
+         docs/stability.md, \"Damped membrane bonds\"); lower the damping ratio to at most \
+         {largest_ratio:.3}, or dt to at most {largest_step:.4e} s"
+    )]
+    BondDashpotsTooStiff {
+        dt: f64,
+        number: f64,
+        limit: f64,
+        body: usize,
+        largest_ratio: f64,
+        largest_step: f64,
+    },
     #[error("body {body}: non-finite state at step {step} (position or velocity is NaN/inf); {}", blame(*step))]
     NonFinite { body: usize, step: u64 },
     #[error(

@@ -37,6 +37,7 @@ pub use error::DemError;
 pub use history::{Histories, HistoryData};
 pub use neighbor::Contacts;
 pub use shape::{Ball, ClumpShape, MassProps2};
+pub use stepper::bond_dashpots::{BOND_DASHPOT_LIMIT, BondDashpotLimit};
 pub use stepper::{ForceHook, StepParams, Stepper, WallContactStep};
 pub use system::{Membrane, System};
 pub use vector::{Vec2, Vec3, Vector};

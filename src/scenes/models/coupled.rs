@@ -220,7 +220,7 @@ impl<T: Real> CoupledModel<T> {
             && sc.confine_liquid
         {
             if sc.membrane_boundary == MembraneBoundary::Moving {
-                heavy_membrane(&run, s)?;
+                damped_membrane(s)?;
             }
             run = run
                 .with_confinement(vec![c.cell.plate], sc.membrane_boundary)
@@ -530,39 +530,30 @@ impl<T: Real> Model for CoupledModel<T> {
     }
 }
 
-/// Lightest membrane grain, over the liquid's density, that the moving membrane boundary
-/// carries. The reduced cell with every grain scaled blew up at 0.90 (LBM step 77) and reached
-/// a largest lattice Mach number of 0.28 and 0.38 at 1.08 and 1.35; with the membrane alone
-/// scaled, 0.12 at 1.80, 0.067 at 2.7 and 0.043 at 3.6, against 0.049 with the zone at rest
-/// (docs/su2020.md, "The liquid confined to the sample"). Not a guarantee: on six random
-/// replicas of the reduced cell at the paper's DEM step, 2.7 times blew up in all six with the
-/// membrane's newest velocity shown as it is, and in none under-relaxed by ½ (the default,
-/// `[shear_cell] membrane_relaxation`); 1.8 times blew up in all six at ½ and in four at ¼
-/// (docs/su2020.md, "Under-relaxing the membrane's velocity").
-pub const MOVING_MEMBRANE_DENSITY_MIN: f64 = 2.5;
+/// Least damping ratio of the membrane's bonds (`[bonds] params.damping`) with which the moving
+/// membrane boundary runs. Undamped, membrane grains ring on their bonds, their velocity flipping
+/// sign every LBM step, driven by the liquid that answers their motion a step late (the velocity
+/// shown is last cycle's mean, under-relaxed), until the lattice blows up (docs/su2020.md, "The
+/// membrane's bonds must be damped"). On the reduced cell's six random
+/// assemblies at the paper's membrane mass and two LBM steps: ζ = 0.05 blew up in 6 of 12, 0.1
+/// ran all 12 but reached Mach 0.21, 0.2 ran all 12 below Mach 0.06 (and all 12 with the membrane
+/// three times heavier, below 0.03). Undamped, even a membrane 2.7 times the liquid's density
+/// blew up in all six at the halved LBM step.
+pub const MOVING_MEMBRANE_BOND_DAMPING_MIN: f64 = 0.2;
 
-/// Refuse a membrane that shows the liquid its velocity if its grains are too light to take the
-/// reaction explicitly ([`MOVING_MEMBRANE_DENSITY_MIN`]).
-fn heavy_membrane<T: Real>(run: &Coupled<T>, s: &Scene) -> Result<()> {
-    let Some(mem) = &run.sys.membrane else {
+/// Refuse a membrane that shows the liquid its velocity if its bonds are not damped enough to
+/// stop it ringing ([`MOVING_MEMBRANE_BOND_DAMPING_MIN`]).
+fn damped_membrane(s: &Scene) -> Result<()> {
+    let Some(b) = &s.bonds else {
         return Ok(());
     };
-    let b = &run.sys.bodies;
-    let lightest = mem
-        .bodies
-        .iter()
-        .map(|&k| b.density[k as usize] / run.depth)
-        .fold(f64::INFINITY, f64::min);
-    let ratio = lightest / run.liquid_density();
-    if ratio < MOVING_MEMBRANE_DENSITY_MIN {
-        let now = s.membrane.as_ref().map_or(1.0, |m| m.mass_scale);
-        let need = now * MOVING_MEMBRANE_DENSITY_MIN / ratio;
+    let zeta = b.params.damping;
+    if zeta < MOVING_MEMBRANE_BOND_DAMPING_MIN {
         bail!(
-            "[shear_cell] membrane_boundary = \"moving\": the lightest membrane grain is {lightest:.1} kg/m³, \
-             {ratio:.3} times the liquid's {} kg/m³; a membrane that moves the liquid feels its reaction \
-             explicitly and is unstable below {MOVING_MEMBRANE_DENSITY_MIN} (docs/su2020.md). Set [membrane] \
-             mass_scale to at least {need:.3} (now {now}), or membrane_boundary = \"at_rest\"",
-            run.liquid_density()
+            "[shear_cell] membrane_boundary = \"moving\": the membrane's bonds have damping ratio {zeta} \
+             ([bonds] params.damping); an undamped membrane rings on its bonds and the liquid, answering \
+             a step late, drives the ringing until the lattice blows up (docs/su2020.md). Set [bonds] \
+             params.damping to at least {MOVING_MEMBRANE_BOND_DAMPING_MIN}, or membrane_boundary = \"at_rest\""
         );
     }
     Ok(())

@@ -226,6 +226,7 @@ const RULES: &[Rule] = &[
     ),
     Rule("bonds.params.cohesion", Need::NonNegative, "bond cohesion (Pa)"),
     Rule("bonds.params.lambda", Need::Positive, "bond radius multiplier"),
+    Rule("bonds.params.damping", Need::BelowOne, "bond damping ratio ζ"),
     Rule("membrane.shell", Need::Positive, "membrane shell thickness (m)"),
     Rule(
         "membrane.threshold",

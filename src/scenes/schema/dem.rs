@@ -119,11 +119,11 @@ pub struct MembraneSection {
     /// paper's step, which keeps a grain resting at the threshold vibrating: `lbdem_dem::Membrane`).
     #[serde(default)]
     pub ramp: f64,
-    /// Factor on the membrane grains' masses and inertias (default 1). A membrane that shows
-    /// the liquid its velocity (`[shear_cell] membrane_boundary = "moving"`) feels the liquid's
-    /// reaction explicitly and needs grains at least 2.5 times the liquid's density
-    /// (docs/su2020.md, "The liquid confined to the sample"); the membrane is the model's
-    /// confinement, not material of the sample.
+    /// Factor on the membrane grains' masses and inertias (default 1): the membrane is the
+    /// model's confinement, not material of the sample. Until 2026-11-29 a membrane that shows
+    /// the liquid its velocity (`[shear_cell] membrane_boundary = "moving"`) needed grains 2.5
+    /// times the liquid's density; it now needs damped bonds instead (`[bonds] params.damping`,
+    /// docs/su2020.md, "The membrane's bonds must be damped").
     #[serde(default = "one")]
     pub mass_scale: f64,
 }

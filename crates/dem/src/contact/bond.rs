@@ -4,6 +4,7 @@
 //! I = (2/3) R̄³. Forces grow incrementally from the relative motion:
 //! ΔF_n = k̄_n A Δu_n, ΔF_s = −k̄_s A Δu_s, ΔM = −k̄_n I Δθ. The bond breaks when the tensile stress
 //! σ = F_n/A + |M| R̄/I reaches σ_c or the shear stress τ = |F_s|/A reaches the cohesion c.
+//! Optional dashpots (`BondParams::damping`) beside the normal and shear springs.
 
 use super::ContactInput;
 use crate::vector::{Vec2, Vector};
@@ -22,6 +23,13 @@ pub struct BondParams {
     pub cohesion: f64,
     /// Bond radius multiplier λ̄ (Su et al.: 0.5).
     pub lambda: f64,
+    /// Damping ratio ζ of a dashpot beside each of the normal and shear springs (0, the
+    /// default: Potyondy & Cundall's undamped bond). An undamped membrane under a liquid that
+    /// answers its motion a step late rings on its bonds at the LBM step's period until the
+    /// lattice blows up (docs/su2020.md, "The membrane's bonds must be damped"); ζ = 0.2 stops
+    /// it.
+    #[serde(default)]
+    pub damping: f64,
 }
 
 /// A parallel bond between circles `i` and `j`, with its stored forces.
@@ -71,7 +79,14 @@ impl Bond {
             self.broken = true;
             return (Vec2::ZERO, 0.0);
         }
-        // Tension pulls i toward j (along +n).
-        (c.n * self.f_n + t * self.f_s, self.m)
+        // Tension pulls i toward j (along +n). The dashpots act on the relative velocity
+        // (c = 2ζ √(k̄ A m*)); they are not stored in the bond and do not break it.
+        let mut f = c.n * self.f_n + t * self.f_s;
+        if p.damping > 0.0 {
+            let cn = 2.0 * p.damping * (p.k_n * area * c.m_eff).sqrt();
+            let cs = 2.0 * p.damping * (p.k_s * area * c.m_eff).sqrt();
+            f -= c.n * (cn * vn) + t * (cs * c.v_rel.dot(t));
+        }
+        (f, self.m)
     }
 }

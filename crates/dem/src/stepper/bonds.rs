@@ -1,6 +1,7 @@
 //! Parallel bonds, sequentially in bond order.
 
 use super::Stepper;
+use super::bond_dashpots::reduced_mass;
 use crate::contact::ContactInput;
 use crate::system::System;
 use crate::vector::Vector;
@@ -28,7 +29,7 @@ impl Stepper {
                     v_rel: vi - vj,
                     w_rel: bodies.omega[bi] - bodies.omega[bj],
                     r_eff: ri * rj / (ri + rj),
-                    m_eff: 0.0,
+                    m_eff: reduced_mass(bodies.mass[bi], bodies.mass[bj]),
                     dt,
                 };
                 let (f, m) = bond.update(&bp, &c, ri, rj);

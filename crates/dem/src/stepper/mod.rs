@@ -20,6 +20,7 @@
 //! sum that starts at +0.0), so the order, hence every bit, is independent of the thread count
 //! and of the step at which the Verlet list was rebuilt (a resumed run continues bit for bit).
 
+pub mod bond_dashpots;
 mod bonds;
 mod disks;
 mod finish;
@@ -246,6 +247,18 @@ impl Stepper {
                 body: wall.body,
                 k_wall: wall.k,
                 c_wall: wall.c,
+            });
+        }
+        if let Some(b) = Self::bond_dashpot_number(sys, dt)
+            && b.number > bond_dashpots::BOND_DASHPOT_LIMIT
+        {
+            return Err(DemError::BondDashpotsTooStiff {
+                dt,
+                number: b.number,
+                limit: bond_dashpots::BOND_DASHPOT_LIMIT,
+                body: b.body,
+                largest_ratio: b.largest_ratio,
+                largest_step: dt * bond_dashpots::BOND_DASHPOT_LIMIT / b.number,
             });
         }
         let limit = Self::largest_accepted_step(sys, law, wall_law);
