@@ -34,10 +34,9 @@ pub enum MembraneBoundary {
     #[default]
     AtRest,
     /// A wall moving with the membrane (velocity interpolated along the polygon's edges), whose
-    /// reaction the membrane grains feel. Explicit, a step behind: a membrane that rings on
-    /// undamped bonds at a period of a few LBM steps is driven by it until the lattice blows up;
-    /// with damped bonds it runs at the paper's masses (docs/su2020.md, "The membrane's bonds
-    /// must be damped").
+    /// reaction the membrane grains feel. Explicit, a step behind: a membrane on undamped bonds
+    /// rings under it at the LBM step's period until the lattice blows up; with damped bonds it
+    /// runs at the paper's masses (docs/su2020.md, "The membrane's bonds must be damped").
     Moving,
 }
 
@@ -131,7 +130,8 @@ impl Confinement {
     /// times the liquid's density, ω = 1 blew up in all six, ½ and ¼ in none; at 1.8 times ½
     /// blew up in all six and ¼ in four, at 0.9 times ½ in two and ¼ in none (docs/su2020.md,
     /// "Under-relaxing the membrane's velocity"). The cure was damping the membrane's bonds: the
-    /// blow-ups were the membrane ringing on them, driven by the late reaction. What it shows lags the membrane by (1 − ω)/ω
+    /// blow-ups were the membrane ringing on them, driven by the late reaction. What it shows
+    /// lags the membrane by (1 − ω)/ω
     /// LBM steps on average: at ω = ½ and Su's 30 µm/s with Table 3's step, 20 nm of membrane
     /// travel, 0.05 % of a 40 µm cell.
     pub fn set_relaxation(&mut self, omega: f64) -> Result<(), CouplingError> {
