@@ -24,27 +24,15 @@ pub struct BondDashpotLimit {
     pub largest_ratio: f64,
 }
 
-/// m_i m_j / (m_i + m_j), the mass the bond's dashpots are set for; a fixed body (infinite mass)
-/// gives the other's mass.
+/// m_i m_j / (m_i + m_j), the mass the bond's dashpots are set for (as the pair law's m*).
+#[inline]
 pub(super) fn reduced_mass(mi: f64, mj: f64) -> f64 {
-    if mi.is_infinite() {
-        mj
-    } else if mj.is_infinite() {
-        mi
-    } else {
-        mi * mj / (mi + mj)
-    }
+    mi * mj / (mi + mj)
 }
 
-/// 1/m + (a × e)²/I of a body at arm `a` along unit `e`; a fixed body (infinite mass) adds 0.
+/// 1/m + (a × e)²/I of a body at arm `a` along unit `e`.
 fn inverse_mass(m: f64, inertia: f64, a: Vec2, e: Vec2) -> f64 {
-    let lin = if m.is_finite() && m > 0.0 { 1.0 / m } else { 0.0 };
-    let ang = if inertia.is_finite() && inertia > 0.0 {
-        a.cross(e).powi(2) / inertia
-    } else {
-        0.0
-    };
-    lin + ang
+    1.0 / m + a.cross(e).powi(2) / inertia
 }
 
 impl Stepper {
