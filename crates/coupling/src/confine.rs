@@ -24,6 +24,7 @@ use lbdem_dem::Vec2;
 use lbdem_dem::polygon::{plate_region, scan_rows};
 use lbdem_dem::vector::Vector;
 use lbdem_lbm::Real;
+use rayon::prelude::*;
 
 /// What the liquid sees outside the membrane polygon.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -73,6 +74,8 @@ pub struct Confinement {
     edge_nodes: Vec<EdgeNode>,
     /// Scratch: squared distance to the nearest edge found so far, and that edge (`Moving`).
     nearest: Vec<(f64, u32, f64)>,
+    /// Velocity slots of the edge nodes (`Moving`), kept while a node stays on the edge.
+    slots: EdgeSlots,
     /// Where each membrane grain (ring order) was at the last call of [`Confinement::zone`]
     /// (`Moving`): the boundary shows its mean velocity over the last LBM cycle.
     previous: Vec<Vec2>,
@@ -115,6 +118,7 @@ impl Confinement {
             velocities: Vec::new(),
             edge_nodes: Vec::new(),
             nearest: Vec::new(),
+            slots: EdgeSlots::default(),
             previous: Vec::new(),
             shown: Vec::new(),
             relaxation: 1.0,
@@ -194,12 +198,12 @@ impl Confinement {
             .map(to_lattice)
             .collect();
         fill(&ring, nx, ny, |i| self.zone[i] = LIQUID);
-        self.edge_nodes.clear();
-        let first_edge_index = 1 + self.plates.len() as u32;
-        if self.boundary == MembraneBoundary::Moving {
-            let ids: Vec<u32> = self.order.iter().map(|&k| mem.bodies[k]).collect();
-            self.edges(&ring, &ids, nx, ny, first_edge_index);
-        }
+        let old_edges = std::mem::take(&mut self.edge_nodes);
+        let candidates = if self.boundary == MembraneBoundary::Moving {
+            self.edges(&ring, nx, ny)
+        } else {
+            Vec::new()
+        };
         // One velocity per plate, then the edges' (from `first_edge_index` on).
         for (k, &w) in self.plates.iter().enumerate() {
             let wall = &sys.walls[w];
@@ -209,6 +213,35 @@ impl Confinement {
             let quad: Vec<Vec2> = q.into_iter().map(to_lattice).collect();
             let z = 1 + k as u32;
             fill(&quad, nx, ny, |i| self.zone[i] = z);
+        }
+        if self.boundary == MembraneBoundary::Moving {
+            // A plate drawn over an edge node takes it.
+            let m = self.order.len();
+            let edges: Vec<(usize, u32, f64)> = candidates
+                .into_iter()
+                .filter(|&(idx, _, _)| self.zone[idx] == 0)
+                .collect();
+            let first_edge_index = 1 + self.plates.len() as u32;
+            let slots = self.slots.assign(
+                nx * ny,
+                old_edges.iter().map(|e| e.node),
+                edges.iter().map(|e| e.0),
+            );
+            for (&(node, e, t), slot) in edges.iter().zip(slots) {
+                let index = first_edge_index + slot;
+                self.zone[node] = index;
+                self.edge_nodes.push(EdgeNode {
+                    node,
+                    index,
+                    a: mem.bodies[self.order[e as usize]],
+                    b: mem.bodies[self.order[(e as usize + 1) % m]],
+                    ra: e,
+                    rb: ((e as usize + 1) % m) as u32,
+                    t,
+                });
+            }
+            self.velocities
+                .resize(first_edge_index as usize + self.slots.len(), [0.0; 3]);
         }
         if self.boundary == MembraneBoundary::Moving {
             let b = &sys.bodies;
@@ -243,18 +276,15 @@ impl Confinement {
                 let (va, vb) = (shown[e.ra as usize], shown[e.rb as usize]);
                 let v = va * (1.0 - e.t) + vb * e.t;
                 let v = units.velocity_to_lattice([v.x, v.y]);
-                self.velocities.push([v[0], v[1], 0.0]);
+                self.velocities[e.index as usize] = [v[0], v[1], 0.0];
             }
-            // A plate drawn over an edge node takes it.
-            let zone = &self.zone;
-            self.edge_nodes.retain(|e| zone[e.node] == e.index);
         }
         (&self.zone, &self.velocities)
     }
 
-    /// Give each zone node within [`EDGE_REACH`] of the polygon `ring` (lattice coordinates;
-    /// `ids` its grains) the nearest edge, and a velocity index from `first` on.
-    fn edges(&mut self, ring: &[Vec2], ids: &[u32], nx: usize, ny: usize, first: u32) {
+    /// The zone nodes within [`EDGE_REACH`] of the polygon `ring` (lattice coordinates), each
+    /// with its nearest edge and its place on it, in the order they were first reached.
+    fn edges(&mut self, ring: &[Vec2], nx: usize, ny: usize) -> Vec<(usize, u32, f64)> {
         let n = nx * ny;
         if self.nearest.len() != n {
             self.nearest = vec![(f64::INFINITY, 0, 0.0); n];
@@ -287,21 +317,14 @@ impl Confinement {
                 }
             }
         }
-        for (k, &idx) in touched.iter().enumerate() {
-            let (_, e, t) = self.nearest[idx];
-            self.nearest[idx].0 = f64::INFINITY;
-            let index = first + k as u32;
-            self.zone[idx] = index;
-            self.edge_nodes.push(EdgeNode {
-                node: idx,
-                index,
-                a: ids[e as usize],
-                b: ids[(e as usize + 1) % m],
-                ra: e,
-                rb: ((e as usize + 1) % m) as u32,
-                t,
-            });
-        }
+        touched
+            .into_iter()
+            .map(|idx| {
+                let (_, e, t) = self.nearest[idx];
+                self.nearest[idx].0 = f64::INFINITY;
+                (idx, e, t)
+            })
+            .collect()
     }
 
     /// With the zone of this step laid on `fluid` (`Moving` only; nothing at rest): take out
@@ -313,11 +336,16 @@ impl Confinement {
         if self.boundary != MembraneBoundary::Moving {
             return;
         }
-        let ex: Vec<_> = self
-            .edge_nodes
-            .iter()
-            .map(|e| fluid.zone_exchange(e.node))
-            .collect();
+        // Each node's exchange reads the fluid only; collected in edge order, so the sums below
+        // are the same on any number of threads.
+        let ex: Vec<_> = {
+            let f = &*fluid;
+            self.edge_nodes
+                .par_iter()
+                .with_min_len(64)
+                .map(|e| f.zone_exchange(e.node))
+                .collect()
+        };
         let injected: f64 = ex.iter().map(|e| e.mass).sum();
         let (mass, nodes) = fluid.liquid_mass_nodes();
         if nodes == 0 || mass <= 0.0 {
@@ -337,6 +365,72 @@ impl Confinement {
     }
 }
 
+/// Velocity slots of the moving boundary's edge nodes. A node keeps its slot for as long as it
+/// stays on the edge, so its zone value does not change from one LBM step to the next and
+/// [`PsmFluid::set_zone`] relinks only the nodes that joined or left the edge. When every edge
+/// node took a fresh index each step (its rank in the edge search), one changed node renumbered
+/// all after it and the whole outline and its neighbours were relinked every step: the solid
+/// zone then cost 1.6 ms per LBM step on Simulation I against about 0.5 ms at rest (docs/su2020.md).
+/// The slot numbers carry no physics: which slot a node holds changes only which entry of the
+/// velocity table it reads, so a run that restarts with fresh slots gives the same bits.
+#[derive(Clone, Debug, Default)]
+struct EdgeSlots {
+    /// Slot of each node, or [`EdgeSlots::NONE`].
+    of: Vec<u32>,
+    /// Slots freed by nodes that left the edge, reused last-freed first.
+    free: Vec<u32>,
+    /// Slots handed out so far (the velocity table's length after the plates).
+    count: u32,
+    /// Scratch: which nodes are on the edge in this step.
+    now: Vec<bool>,
+}
+
+impl EdgeSlots {
+    const NONE: u32 = u32::MAX;
+
+    fn len(&self) -> usize {
+        self.count as usize
+    }
+
+    /// Free the slots of the nodes in `before` that are not in `after`, then return the slot of
+    /// each node of `after` (its old one, else a freed or a new one), in `after`'s order.
+    fn assign(
+        &mut self,
+        n: usize,
+        before: impl Iterator<Item = usize>,
+        after: impl Iterator<Item = usize> + Clone,
+    ) -> Vec<u32> {
+        if self.of.len() != n {
+            *self = Self {
+                of: vec![Self::NONE; n],
+                now: vec![false; n],
+                ..Self::default()
+            };
+        }
+        for idx in after.clone() {
+            self.now[idx] = true;
+        }
+        for idx in before {
+            if !self.now[idx] && self.of[idx] != Self::NONE {
+                self.free.push(self.of[idx]);
+                self.of[idx] = Self::NONE;
+            }
+        }
+        after
+            .map(|idx| {
+                self.now[idx] = false;
+                if self.of[idx] == Self::NONE {
+                    self.of[idx] = self.free.pop().unwrap_or_else(|| {
+                        self.count += 1;
+                        self.count - 1
+                    });
+                }
+                self.of[idx]
+            })
+            .collect()
+    }
+}
+
 /// Call `f(node)` for every node whose centre (i + ½, j + ½) lies inside `poly` (lattice
 /// coordinates).
 fn fill(poly: &[Vec2], nx: usize, ny: usize, mut f: impl FnMut(usize)) {
@@ -350,4 +444,26 @@ fn fill(poly: &[Vec2], nx: usize, ny: usize, mut f: impl FnMut(usize)) {
             i += 1.0;
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::EdgeSlots;
+
+    /// A node that stays on the edge keeps its slot, so its zone value does not change and the
+    /// lattice does not relink it; a node that leaves gives its slot to the next newcomer.
+    #[test]
+    fn an_edge_node_keeps_its_slot_while_it_stays_on_the_edge() {
+        let mut s = EdgeSlots::default();
+        let first = s.assign(10, [].into_iter(), [3, 4, 5].into_iter());
+        assert_eq!(first, vec![0, 1, 2]);
+        // 4 leaves, 7 joins before the others in the search order: 3 and 5 keep theirs.
+        let second = s.assign(10, [3, 4, 5].into_iter(), [7, 5, 3].into_iter());
+        assert_eq!(second, vec![1, 2, 0]);
+        assert_eq!(s.len(), 3);
+        // Two join where none left: the table grows.
+        let third = s.assign(10, [7, 5, 3].into_iter(), [7, 5, 3, 8, 9].into_iter());
+        assert_eq!(third, vec![1, 2, 0, 3, 4]);
+        assert_eq!(s.len(), 5);
+    }
 }
