@@ -13,8 +13,9 @@ use crate::LbmError;
 use crate::lattice::{D2Q9, D3Q19};
 use crate::stepper::{Fluid, Macro, Stepper};
 use crate::stepper_aa::StepperAa;
+use crate::storage::{ShiftedF16, ShiftedF32};
 
-/// One step of each stepper, per precision; implemented for every lattice of the crate by
+/// One step of each stepper, per precision (and, for the AA stepper, storage); implemented for every lattice of the crate by
 /// [`compiled!`]. A supertrait of [`crate::Lattice`].
 pub trait Compiled: Sized {
     fn step_two_f64(
@@ -34,6 +35,18 @@ pub trait Compiled: Sized {
     ) -> Result<(), LbmError>;
     fn step_aa_f32(
         st: &mut StepperAa<Self, f32>,
+        fluid: &mut Fluid<Self, f32>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError>;
+    /// f64 arithmetic on f32 storage of f − w (`storage::ShiftedF32`).
+    fn step_aa_f32s(
+        st: &mut StepperAa<Self, f64, ShiftedF32>,
+        fluid: &mut Fluid<Self, f64>,
+        out: Option<&mut Macro>,
+    ) -> Result<(), LbmError>;
+    /// f32 arithmetic on binary16 storage of f − w (`storage::ShiftedF16`).
+    fn step_aa_f16s(
+        st: &mut StepperAa<Self, f32, ShiftedF16>,
         fluid: &mut Fluid<Self, f32>,
         out: Option<&mut Macro>,
     ) -> Result<(), LbmError>;
@@ -73,6 +86,22 @@ macro_rules! compiled {
             #[cfg_attr(test, inline)]
             fn step_aa_f32(
                 st: &mut StepperAa<Self, f32>,
+                fluid: &mut Fluid<Self, f32>,
+                out: Option<&mut Macro>,
+            ) -> Result<(), LbmError> {
+                st.step_generic(fluid, out)
+            }
+            #[cfg_attr(test, inline)]
+            fn step_aa_f32s(
+                st: &mut StepperAa<Self, f64, ShiftedF32>,
+                fluid: &mut Fluid<Self, f64>,
+                out: Option<&mut Macro>,
+            ) -> Result<(), LbmError> {
+                st.step_generic(fluid, out)
+            }
+            #[cfg_attr(test, inline)]
+            fn step_aa_f16s(
+                st: &mut StepperAa<Self, f32, ShiftedF16>,
                 fluid: &mut Fluid<Self, f32>,
                 out: Option<&mut Macro>,
             ) -> Result<(), LbmError> {

@@ -19,16 +19,18 @@ use crate::lattice::{Lattice, QMAX};
 use crate::layout::Layout;
 use crate::plan::{Plan, Upstream, neighbour};
 use crate::real::Real;
+use crate::storage::Storage;
 use lbdem_core::simd::Simd;
 
 /// First node of a row that left the limits: (x, ρ, u).
 pub type Bad = Option<(usize, f64, [f64; 3])>;
 
-pub struct CtxAa<'a, T, C> {
+pub struct CtxAa<'a, T, C, St = T> {
     pub dom: &'a Domain,
     pub plan: &'a Plan,
-    /// The single population array (read and written through raw pointers only), in `layout`.
-    pub f: SyncPtr<T>,
+    /// The single population array (read and written through raw pointers only), in `layout`,
+    /// stored as `St` (`storage`: the values themselves or their shifted, narrower form).
+    pub f: SyncPtr<St>,
     pub layout: Layout,
     /// The collision operator (uniform `CollideParams` or per-node `LocalRates`).
     pub coll: C,
@@ -39,7 +41,12 @@ pub struct CtxAa<'a, T, C> {
 
 /// Range check of a block of `B` nodes starting at node `idx0` (and the macroscopic output).
 #[inline(always)]
-fn check<T: Real, C, const B: usize>(ctx: &CtxAa<T, C>, m: &Moments<T, B>, idx0: usize, bad: &mut Bad) {
+fn check<T: Real, C, St, const B: usize>(
+    ctx: &CtxAa<T, C, St>,
+    m: &Moments<T, B>,
+    idx0: usize,
+    bad: &mut Bad,
+) {
     let bits = ctx.limits.bad_lanes(&m.rho, &m.usq);
     if bits != 0 {
         keep_lowest_x(bad, first_bad(ctx, m, idx0, bits));
@@ -73,8 +80,8 @@ fn keep_lowest_x(bad: &mut Bad, cand: Bad) {
 /// The first node of a block flagged in `bits`, for the diagnosis (rare: kept out of line).
 #[cold]
 #[inline(never)]
-fn first_bad<T: Real, C, const B: usize>(
-    ctx: &CtxAa<T, C>,
+fn first_bad<T: Real, C, St, const B: usize>(
+    ctx: &CtxAa<T, C, St>,
     m: &Moments<T, B>,
     idx0: usize,
     bits: u32,
@@ -89,8 +96,8 @@ fn first_bad<T: Real, C, const B: usize>(
 /// # Safety
 /// `ctx.f` must hold Q `ctx.layout.stride` values; no other thread may touch the nodes of row `r`.
 #[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
-pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
-    ctx: &CtxAa<T, C>,
+pub unsafe fn even_row<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const F: bool, S: Simd>(
+    ctx: &CtxAa<T, C, St>,
     r: usize,
 ) -> Bad {
     let dom = ctx.dom;
@@ -109,7 +116,7 @@ pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S:
         dst[i] = L::OPP[i] * n + slot_off;
     }
     for &(x0, x1) in &plan.runs[plan.run_start[r] as usize..plan.run_start[r + 1] as usize] {
-        unsafe { run::<L, T, C, F, S>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
+        unsafe { run::<L, T, St, C, F, S>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     bad
 }
@@ -119,8 +126,8 @@ pub unsafe fn even_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S:
 /// # Safety
 /// The slots must be in bounds and belong to nodes of the calling row (module doc).
 #[inline(always)]
-unsafe fn block<L: Lattice, T: Real, C: Collider<L, T>, const B: usize, const F: bool>(
-    ctx: &CtxAa<T, C>,
+unsafe fn block<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const B: usize, const F: bool>(
+    ctx: &CtxAa<T, C, St>,
     f: &mut [[T; B]; QMAX],
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
@@ -128,14 +135,10 @@ unsafe fn block<L: Lattice, T: Real, C: Collider<L, T>, const B: usize, const F:
     node: usize,
     bad: &mut Bad,
 ) {
-    for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-        unsafe { std::ptr::copy_nonoverlapping(ctx.f.0.add(src[i].wrapping_add(x)), fi.as_mut_ptr(), B) };
-    }
+    unsafe { St::gather::<L, B>(ctx.f.0, src, x, f) };
     let m = C::collide::<B, F>(&ctx.coll, f, node);
-    for (i, fi) in f.iter().enumerate().take(L::Q) {
-        unsafe { std::ptr::copy_nonoverlapping(fi.as_ptr(), ctx.f.0.add(dst[i].wrapping_add(x)), B) };
-    }
-    check::<T, C, B>(ctx, &m, node, bad);
+    unsafe { St::scatter::<L, B>(ctx.f.0, dst, x, f) };
+    check::<T, C, St, B>(ctx, &m, node, bad);
 }
 
 /// Nodes [x0, x1) of a row in blocks of `kernel::block_width::<T, S>()` nodes (two AVX-512
@@ -145,8 +148,8 @@ unsafe fn block<L: Lattice, T: Real, C: Collider<L, T>, const B: usize, const F:
 /// # Safety
 /// As `block`.
 #[inline(always)]
-unsafe fn run<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
-    ctx: &CtxAa<T, C>,
+unsafe fn run<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const F: bool, S: Simd>(
+    ctx: &CtxAa<T, C, St>,
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
     x0: usize,
@@ -154,12 +157,12 @@ unsafe fn run<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
     node_off: usize,
     bad: &mut Bad,
 ) {
-    unsafe { at_block_width!(T, S, WB => run_w::<L, T, C, F, WB>(ctx, src, dst, x0, x1, node_off, bad)) }
+    unsafe { at_block_width!(T, S, WB => run_w::<L, T, St, C, F, WB>(ctx, src, dst, x0, x1, node_off, bad)) }
 }
 
 #[inline(always)]
-unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB: usize>(
-    ctx: &CtxAa<T, C>,
+unsafe fn run_w<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const F: bool, const WB: usize>(
+    ctx: &CtxAa<T, C, St>,
     src: &[usize; QMAX],
     dst: &[usize; QMAX],
     x0: usize,
@@ -171,7 +174,7 @@ unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB:
     let mut f = [[T::default(); WB]; QMAX];
     let mut x = x0;
     while x + WB <= x1 {
-        unsafe { block::<L, T, C, WB, F>(ctx, &mut f, src, dst, x, node_off + x, bad) };
+        unsafe { block::<L, T, St, C, WB, F>(ctx, &mut f, src, dst, x, node_off + x, bad) };
         x += WB;
     }
     macro_rules! tail {
@@ -179,7 +182,7 @@ unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB:
             // not compiled at all where the block is narrower (`const { }`)
             if const { $b < WB } && $b <= x1 - x {
                 let mut g = [[T::default(); $b]; QMAX];
-                unsafe { block::<L, T, C, $b, F>(ctx, &mut g, src, dst, x, node_off + x, bad) };
+                unsafe { block::<L, T, St, C, $b, F>(ctx, &mut g, src, dst, x, node_off + x, bad) };
                 x += $b;
             }
         };
@@ -198,8 +201,8 @@ unsafe fn run_w<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, const WB:
 /// As `even_row`; the slots a node touches are its own (see the module doc), so rows may run
 /// concurrently.
 #[inline(always)] // into each instruction-set level's copy (`lbdem_core::simd`)
-pub unsafe fn odd_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd>(
-    ctx: &CtxAa<T, C>,
+pub unsafe fn odd_row<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const F: bool, S: Simd>(
+    ctx: &CtxAa<T, C, St>,
     r: usize,
 ) -> Bad {
     let dom = ctx.dom;
@@ -225,29 +228,29 @@ pub unsafe fn odd_row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: 
     }
     let plan = ctx.plan;
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
-        unsafe { run::<L, T, C, F, S>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
+        unsafe { run::<L, T, St, C, F, S>(ctx, &up, &down, x0 as usize, x1 as usize, row_off, &mut bad) };
     }
     for &x in &plan.wraps[plan.wrap_start[r] as usize..plan.wrap_start[r + 1] as usize] {
         let x = x as usize;
         let mut f = [[T::default(); 1]; QMAX];
         for (i, fi) in f.iter_mut().enumerate().take(L::Q) {
-            fi[0] = unsafe { *ctx.f.0.add(up_row[i] + wrap(x, -L::C[i][0], nx)) };
+            fi[0] = unsafe { St::load::<L>(ctx.f.0, up_row[i] + wrap(x, -L::C[i][0], nx), L::OPP[i]) };
         }
         let m = C::collide::<1, F>(&ctx.coll, &mut f, row_off + x);
         for (i, fi) in f.iter().enumerate().take(L::Q) {
-            unsafe { *ctx.f.0.add(down_row[i] + wrap(x, L::C[i][0], nx)) = fi[0] };
+            unsafe { St::store::<L>(ctx.f.0, down_row[i] + wrap(x, L::C[i][0], nx), i, fi[0]) };
         }
-        check::<T, C, 1>(ctx, &m, row_off + x, &mut bad);
+        check::<T, C, St, 1>(ctx, &m, row_off + x, &mut bad);
     }
     for &x in &plan.gens[plan.gen_start[r] as usize..plan.gen_start[r + 1] as usize] {
-        unsafe { odd_general::<L, T, C, F>(ctx, [x as usize, y, z], &mut bad) };
+        unsafe { odd_general::<L, T, St, C, F>(ctx, [x as usize, y, z], &mut bad) };
     }
     bad
 }
 
 /// Wall velocity at the link midpoint p + s c/2 towards a solid node `s_idx` (obstacle or inactive).
-fn wall_velocity<C>(
-    ctx: &CtxAa<impl Real, C>,
+fn wall_velocity<T: Real, C, St>(
+    ctx: &CtxAa<T, C, St>,
     p: [usize; 3],
     c: [i32; 3],
     sign: f64,
@@ -264,8 +267,8 @@ fn wall_velocity<C>(
     }
 }
 
-unsafe fn odd_general<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
-    ctx: &CtxAa<T, C>,
+unsafe fn odd_general<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const F: bool>(
+    ctx: &CtxAa<T, C, St>,
     p: [usize; 3],
     bad: &mut Bad,
 ) {
@@ -283,13 +286,15 @@ unsafe fn odd_general<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
         let c = L::C[i];
         // SAFETY (all raw accesses): indices in bounds; slots owned by this node.
         fi[0] = match neighbour(dom, p, [-c[0], -c[1], -c[2]]) {
-            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(lay.slot(L::OPP[i], s)) },
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe {
+                St::load::<L>(ctx.f.0, lay.slot(L::OPP[i], s), L::OPP[i])
+            },
             Upstream::Node(s) => {
                 let uw = wall_velocity(ctx, p, c, -1.0, s);
-                unsafe { *ctx.f.0.add(lay.slot(i, idx)) + T::from_f64(dotw(i, uw)) }
+                unsafe { St::load::<L>(ctx.f.0, lay.slot(i, idx), i) + T::from_f64(dotw(i, uw)) }
             }
             Upstream::Face(fc) => unsafe {
-                *ctx.f.0.add(lay.slot(i, idx)) + T::from_f64(dotw(i, face_velocity(fc)))
+                St::load::<L>(ctx.f.0, lay.slot(i, idx), i) + T::from_f64(dotw(i, face_velocity(fc)))
             },
         };
     }
@@ -298,15 +303,22 @@ unsafe fn odd_general<L: Lattice, T: Real, C: Collider<L, T>, const F: bool>(
         let c = L::C[i];
         let o = L::OPP[i];
         match neighbour(dom, p, c) {
-            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe { *ctx.f.0.add(lay.slot(i, s)) = fi[0] },
+            Upstream::Node(s) if dom.kind[s] == FLUID => unsafe {
+                St::store::<L>(ctx.f.0, lay.slot(i, s), i, fi[0])
+            },
             Upstream::Node(s) => {
                 let uw = wall_velocity(ctx, p, c, 1.0, s);
-                unsafe { *ctx.f.0.add(lay.slot(o, idx)) = fi[0] + T::from_f64(dotw(o, uw)) }
+                unsafe { St::store::<L>(ctx.f.0, lay.slot(o, idx), o, fi[0] + T::from_f64(dotw(o, uw))) }
             }
             Upstream::Face(fc) => unsafe {
-                *ctx.f.0.add(lay.slot(o, idx)) = fi[0] + T::from_f64(dotw(o, face_velocity(fc)))
+                St::store::<L>(
+                    ctx.f.0,
+                    lay.slot(o, idx),
+                    o,
+                    fi[0] + T::from_f64(dotw(o, face_velocity(fc))),
+                )
             },
         }
     }
-    check::<T, C, 1>(ctx, &m, idx, bad);
+    check::<T, C, St, 1>(ctx, &m, idx, bad);
 }

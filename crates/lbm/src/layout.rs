@@ -12,8 +12,6 @@
 //! boundary (`base`), so that the even step's blocks load and store whole lines.
 //! The padding slots are never read or written by the kernel.
 
-use crate::real::Real;
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Layout {
     /// Nodes per row.
@@ -37,8 +35,8 @@ impl Layout {
         }
     }
 
-    /// The padded layout for values of `T` (see the module doc).
-    pub fn padded<T: Real>(n: [usize; 3]) -> Self {
+    /// The padded layout for stored values of `T` (see the module doc).
+    pub fn padded<T>(n: [usize; 3]) -> Self {
         let size = std::mem::size_of::<T>();
         let line = 64 / size;
         let nxp = n[0].next_multiple_of(line);
@@ -72,7 +70,7 @@ impl Layout {
 
     /// Copy `q` canonical arrays of `n` values into this layout (padding slots zero) and set
     /// `base` so that slot 0 of the new vector is 64-byte aligned.
-    pub fn pack<T: Real>(&mut self, f: &[T], q: usize) -> Vec<T> {
+    pub fn pack<T: Copy + Default>(&mut self, f: &[T], q: usize) -> Vec<T> {
         let n = f.len() / q;
         let size = std::mem::size_of::<T>();
         let mut out = vec![T::default(); q * self.stride + 64 / size];
@@ -88,7 +86,7 @@ impl Layout {
     }
 
     /// Inverse of `pack`: `q` canonical arrays of `n` values.
-    pub fn unpack<T: Real>(&self, f: &[T], q: usize, n: usize) -> Vec<T> {
+    pub fn unpack<T: Copy + Default>(&self, f: &[T], q: usize, n: usize) -> Vec<T> {
         let mut out = vec![T::default(); q * n];
         for i in 0..q {
             for (r, row) in out[i * n..(i + 1) * n].chunks_exact_mut(self.nx).enumerate() {

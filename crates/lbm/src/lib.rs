@@ -29,6 +29,7 @@ pub mod real;
 pub mod roofline;
 pub mod stepper;
 pub mod stepper_aa;
+pub mod storage;
 pub mod zouhe;
 
 pub use bingham::{Bingham, BinghamRates};
@@ -41,6 +42,7 @@ pub use lattice::{D2Q9, D3Q19, Lattice};
 pub use real::Real;
 pub use stepper::{Fluid, ForceTorque, Macro, Settings, Stepper};
 pub use stepper_aa::{Partition, StepperAa};
+pub use storage::{Precision, ShiftedF16, ShiftedF32, Storage, UnknownPrecision};
 
 /// Errors of the LBM engine; each names the parameter, its value, the limit and the fix.
 #[derive(Debug, thiserror::Error)]

@@ -74,7 +74,7 @@ pub fn bad_scalar<T: Real, const B: usize>(rho: &[T; B], usq: &[T; B], lo: T, hi
 /// The two precisions differ only in which compiled kernels they forward to (`compiled.rs`
 /// instantiates each once) and which AVX-512 range check they use.
 macro_rules! real_impl {
-    ($t:ident, $step_two:ident, $step_aa:ident, $bad_block:ident) => {
+    ($t:ident, $step_two:ident, $step_aa:ident, $bad_block:ident, $lanes_v3:literal) => {
         impl Real for $t {
             const NAME: &'static str = stringify!($t);
             #[inline(always)]
@@ -122,14 +122,19 @@ macro_rules! real_impl {
                     // SAFETY: the CPU has AVX-512F (`avx512`).
                     return unsafe { v4::$bad_block(rho, usq, lo, hi, um) };
                 }
+                #[cfg(target_arch = "x86_64")]
+                if avx2() && B.is_multiple_of($lanes_v3) && B <= 32 {
+                    // SAFETY: the CPU has AVX2 (`avx2`).
+                    return unsafe { v3::$bad_block(rho, usq, lo, hi, um) };
+                }
                 bad_scalar(rho, usq, lo, hi, um)
             }
         }
     };
 }
 
-real_impl!(f64, step_two_f64, step_aa_f64, bad_block_f64);
-real_impl!(f32, step_two_f32, step_aa_f32, bad_block_f32);
+real_impl!(f64, step_two_f64, step_aa_f64, bad_block_f64, 4);
+real_impl!(f32, step_two_f32, step_aa_f32, bad_block_f32, 8);
 
 /// Whether the AVX-512 range check may run: always in a `target-cpu=native` build for an
 /// AVX-512 CPU, else when `lbdem_core::simd` runs the kernels at that level (a `OnceLock` read
@@ -138,6 +143,78 @@ real_impl!(f32, step_two_f32, step_aa_f32, bad_block_f32);
 #[inline(always)]
 fn avx512() -> bool {
     cfg!(target_feature = "avx512f") || lbdem_core::simd::level() == lbdem_core::simd::Level::V4
+}
+
+/// Whether the AVX2 range check may run (as [`avx512`]: a build for such a CPU, or the kernels
+/// run at level v3 or above).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn avx2() -> bool {
+    cfg!(target_feature = "avx2") || lbdem_core::simd::level() >= lbdem_core::simd::Level::V3
+}
+
+/// The range check as three vector compares and a sign-mask extraction per 256-bit register:
+/// what `bad_scalar` should compile to with AVX2 but did not (it split the reduction into scalar
+/// compares; on a CPU without AVX-512 every kernel took that path). Inlined into the AVX2 copy of
+/// a kernel (`#[target_feature]` on the copy includes AVX).
+#[cfg(target_arch = "x86_64")]
+mod v3 {
+    use super::lanes;
+    use std::arch::x86_64::*;
+
+    /// # Safety
+    /// AVX present; B a multiple of 4, at most 32.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    pub(super) unsafe fn bad_block_f64<const B: usize>(
+        rho: &[f64; B],
+        usq: &[f64; B],
+        lo: f64,
+        hi: f64,
+        um: f64,
+    ) -> u32 {
+        let mut ok = 0u32;
+        for k in 0..B / 4 {
+            // SAFETY: 4 values from offset 4k < B; the caller checked AVX.
+            let m = unsafe {
+                let r = _mm256_loadu_pd(rho.as_ptr().add(4 * k));
+                let u = _mm256_loadu_pd(usq.as_ptr().add(4 * k));
+                let a = _mm256_cmp_pd::<_CMP_GT_OQ>(r, _mm256_set1_pd(lo));
+                let b = _mm256_cmp_pd::<_CMP_LT_OQ>(r, _mm256_set1_pd(hi));
+                let c = _mm256_cmp_pd::<_CMP_LT_OQ>(u, _mm256_set1_pd(um));
+                _mm256_movemask_pd(_mm256_and_pd(_mm256_and_pd(a, b), c)) as u32
+            };
+            ok |= m << (4 * k);
+        }
+        !ok & lanes(B)
+    }
+
+    /// # Safety
+    /// AVX present; B a multiple of 8, at most 32.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    pub(super) unsafe fn bad_block_f32<const B: usize>(
+        rho: &[f32; B],
+        usq: &[f32; B],
+        lo: f32,
+        hi: f32,
+        um: f32,
+    ) -> u32 {
+        let mut ok = 0u32;
+        for k in 0..B / 8 {
+            // SAFETY: 8 values from offset 8k < B; the caller checked AVX.
+            let m = unsafe {
+                let r = _mm256_loadu_ps(rho.as_ptr().add(8 * k));
+                let u = _mm256_loadu_ps(usq.as_ptr().add(8 * k));
+                let a = _mm256_cmp_ps::<_CMP_GT_OQ>(r, _mm256_set1_ps(lo));
+                let b = _mm256_cmp_ps::<_CMP_LT_OQ>(r, _mm256_set1_ps(hi));
+                let c = _mm256_cmp_ps::<_CMP_LT_OQ>(u, _mm256_set1_ps(um));
+                _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(a, b), c)) as u32
+            };
+            ok |= m << (8 * k);
+        }
+        !ok & lanes(B)
+    }
 }
 
 /// The range check as three masked vector compares per register. Callable from any code

@@ -11,7 +11,7 @@
 //! correct stream-collide kernel on the same array cannot run faster: node updates per second
 //! of this pass are the bound the benchmark divides the kernel's MLUPS by.
 
-use crate::kernel::{SyncPtr, wide};
+use crate::kernel::SyncPtr;
 use crate::layout::Layout;
 use crate::real::Real;
 use crate::stepper_aa::Partition;
@@ -30,6 +30,23 @@ pub fn in_place_pass<T: Real>(
     partition: Partition,
     scale: T,
 ) {
+    in_place_map(f, layout, q, rows, partition, move |v| v * scale);
+}
+
+/// [`in_place_pass`] with any value type and any per-value map `op` (the bound of a narrower
+/// storage, `storage`: e.g. flipping a bit of each 16-bit value moves its bytes with the least
+/// work).
+///
+/// # Panics
+/// If `f` is shorter than `q` direction arrays of the layout.
+pub fn in_place_map<T: Copy + Send + Sync, F: Fn(T) -> T + Copy + Send + Sync>(
+    f: &mut [T],
+    layout: &Layout,
+    q: usize,
+    rows: usize,
+    partition: Partition,
+    op: F,
+) {
     assert!(
         f.len() >= (q - 1) * layout.stride + rows * layout.nxp,
         "array too short for the layout"
@@ -39,7 +56,7 @@ pub fn in_place_pass<T: Real>(
         let p = &ptr;
         for r in t * per..((t + 1) * per).min(rows) {
             // SAFETY: rows of a task belong to it only; indices in bounds (asserted above).
-            unsafe { row(p.0.add(r * layout.nxp), layout.stride, layout.nx, q, scale) };
+            unsafe { row(p.0.add(r * layout.nxp), layout.stride, layout.nx, q, op) };
         }
     };
     match partition {
@@ -57,26 +74,27 @@ pub fn in_place_pass<T: Real>(
     }
 }
 
-/// One row: blocks of `kernel::wide::<T>()` nodes across all `q` arrays, then the scalar rest.
+/// One row: blocks of two AVX-512 registers (128 bytes: `kernel::wide` nodes of f32 and f64)
+/// across all `q` arrays, then the scalar rest.
 ///
 /// # Safety
 /// `p + i * stride + x` must be valid and unshared for i < q, x < nx.
 #[inline(always)]
-unsafe fn row<T: Real>(p: *mut T, stride: usize, nx: usize, q: usize, scale: T) {
-    let wb = wide::<T>();
+unsafe fn row<T: Copy, F: Fn(T) -> T>(p: *mut T, stride: usize, nx: usize, q: usize, op: F) {
+    let wb = 128 / std::mem::size_of::<T>();
     let mut x = 0;
     while x + wb <= nx {
         for i in 0..q {
             // SAFETY: see the function contract.
             let s = unsafe { std::slice::from_raw_parts_mut(p.add(i * stride + x), wb) };
-            s.iter_mut().for_each(|v| *v = *v * scale);
+            s.iter_mut().for_each(|v| *v = op(*v));
         }
         x += wb;
     }
     for i in 0..q {
         // SAFETY: see the function contract.
         let s = unsafe { std::slice::from_raw_parts_mut(p.add(i * stride + x), nx - x) };
-        s.iter_mut().for_each(|v| *v = *v * scale);
+        s.iter_mut().for_each(|v| *v = op(*v));
     }
 }
 

@@ -3,6 +3,11 @@
 //! (post-collision, slot i = f_i), keeps it in its own alternating layout while stepping, and gives
 //! it back canonical with `finish` after an even number of steps. Zou-He faces are not supported
 //! here (use `Stepper`). Forces are refreshed every step from whichever layout the array is in.
+//!
+//! The populations may be stored in a narrower form than the arithmetic type `T` (the third
+//! parameter, `storage::Storage`; `T` itself by default). With `T` the array is the fluid's own
+//! `f`, as before; with a narrower storage the stepper keeps the array and the fluid's `f` is
+//! empty until `finish` (read the state with `canonical` or `export`).
 
 use crate::LbmError;
 use crate::bingham::{Bingham, BinghamRates};
@@ -16,8 +21,10 @@ use crate::layout::Layout;
 use crate::plan::Plan;
 use crate::real::Real;
 use crate::stepper::{Fluid, ForceTorque, Macro, Settings, make_local};
+use crate::storage::Storage;
 use lbdem_core::simd::{self, Simd, WithSimd};
 use rayon::prelude::*;
+use std::any::TypeId;
 use std::marker::PhantomData;
 
 const ROWS_PER_TASK: usize = 4;
@@ -32,7 +39,7 @@ pub enum Partition {
     Contiguous,
 }
 
-pub struct StepperAa<L, T: Real> {
+pub struct StepperAa<L, T: Real, St: Storage<T> = T> {
     settings: Settings,
     params: CollideParams<T>,
     /// Per-node rates (`set_local_tau`) and the τ they came from (diagnosis).
@@ -49,6 +56,8 @@ pub struct StepperAa<L, T: Real> {
     motions: Vec<Motion>,
     /// True when the array is in the reversed layout (next step is odd).
     reversed: bool,
+    /// The population array when `St` is not `T` (else empty: the array is `fluid.f`).
+    store: Vec<St>,
     /// Row partition over the pool (default `Rows(4)`).
     pub partition: Partition,
     pub forces: Vec<ForceTorque>,
@@ -56,9 +65,9 @@ pub struct StepperAa<L, T: Real> {
 }
 
 /// Every row of one AA step with the collision `C`, spread over the pool by `partition`.
-fn run_rows_aa<L: Lattice, T: Real, C: crate::collision::Collider<L, T>>(
+fn run_rows_aa<L: Lattice, T: Real, St: Storage<T>, C: crate::collision::Collider<L, T>>(
     bad: &mut [Bad],
-    ctx: &CtxAa<T, C>,
+    ctx: &CtxAa<T, C, St>,
     partition: Partition,
     odd: bool,
     forced: bool,
@@ -67,10 +76,10 @@ fn run_rows_aa<L: Lattice, T: Real, C: crate::collision::Collider<L, T>>(
     let work = |(c, flags): (usize, &mut [Bad]), rows: usize| {
         let first = c * rows;
         match (odd, forced) {
-            (true, true) => simd::dispatch(RowsAa::<L, T, C, true, true>::new(ctx, first, flags)),
-            (true, false) => simd::dispatch(RowsAa::<L, T, C, true, false>::new(ctx, first, flags)),
-            (false, true) => simd::dispatch(RowsAa::<L, T, C, false, true>::new(ctx, first, flags)),
-            (false, false) => simd::dispatch(RowsAa::<L, T, C, false, false>::new(ctx, first, flags)),
+            (true, true) => simd::dispatch(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags)),
+            (true, false) => simd::dispatch(RowsAa::<L, T, St, C, true, false>::new(ctx, first, flags)),
+            (false, true) => simd::dispatch(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags)),
+            (false, false) => simd::dispatch(RowsAa::<L, T, St, C, false, false>::new(ctx, first, flags)),
         }
     };
     match partition {
@@ -90,15 +99,15 @@ fn run_rows_aa<L: Lattice, T: Real, C: crate::collision::Collider<L, T>>(
 
 /// One task's rows of an AA step (odd or even, forced or not), compiled for each
 /// instruction-set level (`lbdem_core::simd`).
-struct RowsAa<'a, L, T, C, const ODD: bool, const F: bool> {
-    ctx: &'a CtxAa<'a, T, C>,
+struct RowsAa<'a, L, T, St, C, const ODD: bool, const F: bool> {
+    ctx: &'a CtxAa<'a, T, C, St>,
     first: usize,
     flags: &'a mut [Bad],
     _l: PhantomData<L>,
 }
 
-impl<'a, L, T, C, const ODD: bool, const F: bool> RowsAa<'a, L, T, C, ODD, F> {
-    fn new(ctx: &'a CtxAa<'a, T, C>, first: usize, flags: &'a mut [Bad]) -> Self {
+impl<'a, L, T, St, C, const ODD: bool, const F: bool> RowsAa<'a, L, T, St, C, ODD, F> {
+    fn new(ctx: &'a CtxAa<'a, T, C, St>, first: usize, flags: &'a mut [Bad]) -> Self {
         Self {
             ctx,
             first,
@@ -108,8 +117,8 @@ impl<'a, L, T, C, const ODD: bool, const F: bool> RowsAa<'a, L, T, C, ODD, F> {
     }
 }
 
-impl<L: Lattice, T: Real, C: crate::collision::Collider<L, T>, const ODD: bool, const F: bool> WithSimd
-    for RowsAa<'_, L, T, C, ODD, F>
+impl<L: Lattice, T: Real, St: Storage<T>, C: crate::collision::Collider<L, T>, const ODD: bool, const F: bool>
+    WithSimd for RowsAa<'_, L, T, St, C, ODD, F>
 {
     type Output = ();
     #[inline(always)]
@@ -119,16 +128,16 @@ impl<L: Lattice, T: Real, C: crate::collision::Collider<L, T>, const ODD: bool, 
             // SAFETY: every node touches only its own slots (kernel_aa module doc).
             *b = unsafe {
                 if ODD {
-                    kernel_aa::odd_row::<L, T, C, F, S>(self.ctx, r)
+                    kernel_aa::odd_row::<L, T, St, C, F, S>(self.ctx, r)
                 } else {
-                    kernel_aa::even_row::<L, T, C, F, S>(self.ctx, r)
+                    kernel_aa::even_row::<L, T, St, C, F, S>(self.ctx, r)
                 }
             };
         }
     }
 }
 
-fn swap_pairs<L: Lattice, T: Real>(f: &mut [T], n: usize) {
+fn swap_pairs<L: Lattice, T>(f: &mut [T], n: usize) {
     for &i in L::HALF {
         let o = L::OPP[i];
         let (lo, hi) = (i.min(o), i.max(o));
@@ -138,8 +147,34 @@ fn swap_pairs<L: Lattice, T: Real>(f: &mut [T], n: usize) {
 }
 
 impl<L: Lattice, T: Real> StepperAa<L, T> {
-    /// Take `fluid` (canonical layout) into the AA layout.
+    /// Take `fluid` (canonical layout) into the AA layout; populations stored as `T`.
     pub fn new(fluid: &mut Fluid<L, T>, settings: Settings) -> Result<Self, LbmError> {
+        Self::with_storage(fluid, settings)
+    }
+}
+
+impl<L: Lattice, T: Real, St: Storage<T>> StepperAa<L, T, St> {
+    /// The narrower storages run the uniform collision only (BGK or TRT, with or without the
+    /// body force): each collider is compiled once per storage, lattice and instruction-set
+    /// level, and the build of this crate is the longest of CI already (README, "CI's cost").
+    fn uniform_only(what: &str) -> Result<(), LbmError> {
+        if St::SHIFTED {
+            return Err(LbmError::Unsupported(format!(
+                "{what} with population storage {}: use precision f64 or f32 (stored as themselves) for                  local relaxation times",
+                St::NAME
+            )));
+        }
+        Ok(())
+    }
+
+    /// Whether the array is the fluid's own `f` (`St` is `T`).
+    fn in_fluid() -> bool {
+        TypeId::of::<St>() == TypeId::of::<T>()
+    }
+
+    /// Take `fluid` (canonical layout) into the AA layout with populations stored as `St`
+    /// (`storage`); with a narrower storage `fluid.f` is emptied until `finish`.
+    pub fn with_storage(fluid: &mut Fluid<L, T>, settings: Settings) -> Result<Self, LbmError> {
         // same checks as the two-array stepper
         crate::stepper::Stepper::<L, T>::new(fluid, settings)?;
         if fluid.domain.faces.iter().any(|f| f.is_zou_he()) {
@@ -151,8 +186,14 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
         }
         let n = fluid.nodes();
         swap_pairs::<L, T>(&mut fluid.f, n);
-        let mut layout = Layout::padded::<T>(fluid.domain.n);
-        fluid.f = layout.pack(&fluid.f, L::Q);
+        let mut layout = Layout::padded::<St>(fluid.domain.n);
+        let store = if Self::in_fluid() {
+            fluid.f = layout.pack(&fluid.f, L::Q);
+            Vec::new()
+        } else {
+            let f = std::mem::take(&mut fluid.f);
+            layout.pack(&encode::<L, T, St>(&f, n), L::Q)
+        };
         let dom = &fluid.domain;
         let mut motions = fluid.obstacles.clone();
         for fc in dom.faces {
@@ -177,6 +218,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             bad: vec![None; dom.n[1] * dom.n[2]],
             motions,
             reversed: true,
+            store,
             partition: Partition::Rows(ROWS_PER_TASK),
             forces: vec![ForceTorque::default(); fluid.obstacles.len() + 6],
             _l: PhantomData,
@@ -190,9 +232,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
                 "AA stepper finished after an odd number of steps: take one more step first".into(),
             ));
         }
-        let n = fluid.nodes();
-        fluid.f = self.layout.unpack(&fluid.f, L::Q, n);
-        swap_pairs::<L, T>(&mut fluid.f, n);
+        fluid.f = self.canonical(fluid)?;
         Ok(())
     }
 
@@ -210,7 +250,11 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             ));
         }
         let n = fluid.nodes();
-        let mut f = self.layout.unpack(&fluid.f, L::Q, n);
+        let mut f = if Self::in_fluid() {
+            self.layout.unpack(&fluid.f, L::Q, n)
+        } else {
+            decode::<L, T, St>(&self.layout.unpack(&self.store, L::Q, n), n)
+        };
         swap_pairs::<L, T>(&mut f, n);
         Ok(f)
     }
@@ -228,7 +272,8 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
     /// Relax node x with τ⁺ = `tau[x]` (node order); see `Stepper::set_local_tau`. Replaces
     /// Bingham rheology if it was on.
     pub fn set_local_tau(&mut self, tau: Vec<f64>) -> Result<(), LbmError> {
-        let nodes = self.nodes();
+        Self::uniform_only("per-node relaxation times (set_local_tau)")?;
+        let nodes = self.nodes;
         self.local = Some(make_local::<T>(
             &self.settings.collision,
             &mut self.params,
@@ -243,6 +288,9 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
     /// `Stepper::set_bingham` (same kernel arithmetic: both steppers give the same bits). No
     /// state is added: `export` after an even number of steps is still the whole state.
     pub fn set_bingham(&mut self, bingham: Option<Bingham>) -> Result<(), LbmError> {
+        if bingham.is_some() {
+            Self::uniform_only("Bingham rheology (set_bingham)")?;
+        }
         self.bingham = match bingham {
             Some(b) => Some((
                 b,
@@ -276,10 +324,6 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             .unwrap_or(true);
     }
 
-    fn nodes(&self) -> usize {
-        self.nodes
-    }
-
     /// The padded layout the array is kept in between `new` and `finish`.
     pub fn layout(&self) -> Layout {
         self.layout
@@ -293,7 +337,7 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
 
     /// One step (the kernels are compiled in this crate: `compiled`).
     pub fn step(&mut self, fluid: &mut Fluid<L, T>, out: Option<&mut Macro>) -> Result<(), LbmError> {
-        T::step_aa(self, fluid, out)
+        St::step_aa(self, fluid, out)
     }
 
     /// The body of [`StepperAa::step`], instantiated by `compiled` only.
@@ -313,7 +357,13 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             }
         });
         let limits = self.settings.limits.in_precision::<T>();
-        let f = SyncPtr(fluid.f[self.layout.base..].as_mut_ptr());
+        let base = self.layout.base;
+        let f = if Self::in_fluid() {
+            // SAFETY: `St` is `T` (`in_fluid`), so this is a pointer to the array's own type.
+            SyncPtr(fluid.f[base..].as_mut_ptr().cast::<St>())
+        } else {
+            SyncPtr(self.store[base..].as_mut_ptr())
+        };
         let odd = self.reversed;
         let forced = self.settings.force.iter().any(|&x| x != 0.0);
         let (dom, plan, motions, layout, partition) = (
@@ -331,52 +381,57 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             }
             _ => None,
         };
-        match (&self.bingham, &self.local) {
-            (Some((_, rates)), _) => {
-                let ctx = CtxAa {
-                    dom,
-                    plan,
-                    f,
-                    layout,
-                    coll: BinghamRates {
-                        tau: tau_out,
-                        ..*rates
-                    },
-                    motions,
-                    limits,
-                    out,
-                };
-                run_rows_aa::<L, T, _>(&mut self.bad, &ctx, partition, odd, forced);
-            }
-            (None, None) => {
-                let ctx = CtxAa {
-                    dom,
-                    plan,
-                    f,
-                    layout,
-                    coll: self.params,
-                    motions,
-                    limits,
-                    out,
-                };
-                run_rows_aa::<L, T, _>(&mut self.bad, &ctx, partition, odd, forced);
-            }
-            (None, Some((rates, _))) => {
-                let ctx = CtxAa {
-                    dom,
-                    plan,
-                    // slot 0 of the layout (the kernel's offsets do not include `base`)
-                    f,
-                    layout,
-                    coll: LocalRates {
-                        base: self.params,
-                        rates,
-                    },
-                    motions,
-                    limits,
-                    out,
-                };
-                run_rows_aa::<L, T, _>(&mut self.bad, &ctx, partition, odd, forced);
+        // `St::SHIFTED` is a constant: for the narrower storages only the uniform arm is compiled
+        // (`uniform_only`; the others cannot be reached)
+        let uniform = St::SHIFTED || (self.bingham.is_none() && self.local.is_none());
+        if uniform {
+            let ctx = CtxAa {
+                dom,
+                plan,
+                f,
+                layout,
+                coll: self.params,
+                motions,
+                limits,
+                out,
+            };
+            run_rows_aa::<L, T, St, _>(&mut self.bad, &ctx, partition, odd, forced);
+        } else {
+            match (&self.bingham, &self.local) {
+                (Some((_, rates)), _) => {
+                    let ctx = CtxAa {
+                        dom,
+                        plan,
+                        f,
+                        layout,
+                        coll: BinghamRates {
+                            tau: tau_out,
+                            ..*rates
+                        },
+                        motions,
+                        limits,
+                        out,
+                    };
+                    run_rows_aa::<L, T, St, _>(&mut self.bad, &ctx, partition, odd, forced);
+                }
+                (None, Some((rates, _))) => {
+                    let ctx = CtxAa {
+                        dom,
+                        plan,
+                        // slot 0 of the layout (the kernel's offsets do not include `base`)
+                        f,
+                        layout,
+                        coll: LocalRates {
+                            base: self.params,
+                            rates,
+                        },
+                        motions,
+                        limits,
+                        out,
+                    };
+                    run_rows_aa::<L, T, St, _>(&mut self.bad, &ctx, partition, odd, forced);
+                }
+                (None, None) => unreachable!("the uniform arm above"),
             }
         }
         self.reversed = !self.reversed;
@@ -427,7 +482,13 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
                 (self.motions[t].velocity, [0.0; 3])
             };
             let cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1] + c[2] as f64 * uw[2];
-            let stored = fluid.f[self.layout.base + self.layout.slot(o, l.node as usize)].to_f64();
+            let k = self.layout.base + self.layout.slot(o, l.node as usize);
+            let stored = if Self::in_fluid() {
+                fluid.f[k].to_f64()
+            } else {
+                // SAFETY: k is a slot of the array (the links are the plan's).
+                unsafe { St::load::<L>(self.store.as_ptr(), k, o) }.to_f64()
+            };
             let post = if self.reversed {
                 stored
             } else {
@@ -444,4 +505,28 @@ impl<L: Lattice, T: Real> StepperAa<L, T> {
             ft.torque[2] += r[0] * fl[1] - r[1] * fl[0];
         }
     }
+}
+
+/// The stored form of canonical populations `f[i * n + node]` (shifted by w_i where `St` is).
+fn encode<L: Lattice, T: Real, St: Storage<T>>(f: &[T], n: usize) -> Vec<St> {
+    let mut out = vec![St::default(); f.len()];
+    for i in 0..L::Q {
+        for k in 0..n {
+            // SAFETY: k + i n < Q n = len.
+            unsafe { St::store::<L>(out.as_mut_ptr(), i * n + k, i, f[i * n + k]) };
+        }
+    }
+    out
+}
+
+/// Inverse of `encode` (to the stored precision).
+fn decode<L: Lattice, T: Real, St: Storage<T>>(s: &[St], n: usize) -> Vec<T> {
+    let mut out = vec![T::default(); s.len()];
+    for i in 0..L::Q {
+        for k in 0..n {
+            // SAFETY: as in `encode`.
+            out[i * n + k] = unsafe { St::load::<L>(s.as_ptr(), i * n + k, i) };
+        }
+    }
+    out
 }

@@ -14,4 +14,5 @@ mod local_tau;
 mod poiseuille;
 mod sangani_acrivos;
 mod stability;
+mod storage;
 mod taylor_green;
