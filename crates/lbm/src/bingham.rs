@@ -296,6 +296,8 @@ impl<T: Real> BinghamRates<T> {
 }
 
 impl<L: Lattice, T: Real> Collider<L, T> for BinghamRates<T> {
+    const FORCE_TERMS_ALWAYS: bool = true;
+
     #[inline(always)]
     fn collide<const W: usize, const FORCED: bool>(
         &self,

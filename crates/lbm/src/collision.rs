@@ -380,6 +380,12 @@ pub fn bgk_block<L: Lattice, T: Real, const W: usize, const FORCED: bool>(
 /// with ω⁺ read per node: the seam of local-τ rheology such as Bingham, Leonardi et al. 2014
 /// Eqs. 5-8). A new operator is a new type implementing this trait.
 pub trait Collider<L: Lattice, T: Real>: Copy + Send + Sync {
+    /// The steppers compile this collider with the force terms only (no unforced copy): true for
+    /// the per-node operators, whose own work dwarfs the force terms, so that each is built half
+    /// as many times (the crate's build is CI's longest, README "CI's cost"). A zero force gives
+    /// the same result either way (`collide_block`'s `FORCED` note).
+    const FORCE_TERMS_ALWAYS: bool = false;
+
     /// Collide `W` nodes starting at node `node`; the moments the collision used.
     fn collide<const W: usize, const FORCED: bool>(
         &self,
@@ -454,6 +460,8 @@ pub struct LocalRates<'a, T> {
 }
 
 impl<L: Lattice, T: Real> Collider<L, T> for LocalRates<'_, T> {
+    const FORCE_TERMS_ALWAYS: bool = true;
+
     #[inline(always)]
     fn collide<const W: usize, const FORCED: bool>(
         &self,

@@ -6,6 +6,7 @@
 use crate::LbmError;
 use crate::bingham::{Bingham, BinghamRates};
 use crate::collision::{CollideParams, Collider, Collision, LocalRates, NodeRates, equilibrium, local_rates};
+use crate::compiled::Place;
 use crate::diagnosis::BadNode;
 use crate::domain::{Domain, FLUID, Face, Motion};
 use crate::kernel::{self, Ctx, Limits, MacroOut, SyncPtr};
@@ -124,30 +125,44 @@ pub struct Stepper<L, T: Real> {
 /// Rows per rayon task: fixed, so work splitting is the same for every pool size.
 const ROWS_PER_TASK: usize = 4;
 
-/// Every row of one two-array step on the current rayon pool, with the collision `C`.
-fn run_rows<L: Lattice, T: Real, C: Collider<L, T>>(row_good: &mut [bool], ctx: &Ctx<T, C>, forced: bool) {
+/// Every row of one two-array step on the current rayon pool, with the collision `C`. The tasks
+/// run `P::rows_two` (`compiled::Place`: the codegen unit the kernel copies go to).
+fn run_rows<L: Lattice, T: Real, C: Collider<L, T>, P: Place>(
+    row_good: &mut [bool],
+    ctx: &Ctx<T, C>,
+    forced: bool,
+) {
     row_good
         .par_chunks_mut(ROWS_PER_TASK)
         .enumerate()
-        .for_each(|(c, flags)| {
-            let first = c * ROWS_PER_TASK;
-            // One kernel variant per dispatched copy, as the AA stepper (`stepper_aa.rs`).
-            if forced {
-                simd::dispatch(Rows::<L, T, C, true> {
-                    ctx,
-                    first,
-                    flags,
-                    _l: PhantomData,
-                })
-            } else {
-                simd::dispatch(Rows::<L, T, C, false> {
-                    ctx,
-                    first,
-                    flags,
-                    _l: PhantomData,
-                })
-            }
-        });
+        .for_each(|(c, flags)| P::rows_two::<L, T, C>(ctx, c * ROWS_PER_TASK, flags, forced));
+}
+
+/// One task's rows of a two-array step, from row `first`: the body of `Place::rows_two`. One
+/// kernel variant per dispatched copy, as the AA stepper (`stepper_aa::rows_aa`, also for
+/// `Collider::FORCE_TERMS_ALWAYS`).
+#[inline(always)]
+pub(crate) fn rows_two<L: Lattice, T: Real, C: Collider<L, T>>(
+    ctx: &Ctx<T, C>,
+    first: usize,
+    flags: &mut [bool],
+    forced: bool,
+) {
+    if C::FORCE_TERMS_ALWAYS || forced {
+        simd::dispatch(Rows::<L, T, C, true> {
+            ctx,
+            first,
+            flags,
+            _l: PhantomData,
+        })
+    } else {
+        simd::dispatch(Rows::<L, T, C, false> {
+            ctx,
+            first,
+            flags,
+            _l: PhantomData,
+        })
+    }
 }
 
 /// One task's rows (forced or not), compiled for each instruction-set level
@@ -349,7 +364,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
     }
 
     /// The body of [`Stepper::step`], instantiated by `compiled` only.
-    pub(crate) fn step_generic(
+    pub(crate) fn step_generic<P: Place>(
         &mut self,
         fluid: &mut Fluid<L, T>,
         out: Option<&mut Macro>,
@@ -403,7 +418,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
                     limits,
                     out,
                 };
-                run_rows::<L, T, _>(&mut self.row_good, &ctx, forced);
+                run_rows::<L, T, _, P>(&mut self.row_good, &ctx, forced);
             }
             (None, None) => {
                 let ctx = Ctx {
@@ -416,7 +431,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
                     limits,
                     out,
                 };
-                run_rows::<L, T, _>(&mut self.row_good, &ctx, forced);
+                run_rows::<L, T, _, P>(&mut self.row_good, &ctx, forced);
             }
             (None, Some((rates, _))) => {
                 let ctx = Ctx {
@@ -432,7 +447,7 @@ impl<L: Lattice, T: Real> Stepper<L, T> {
                     limits,
                     out,
                 };
-                run_rows::<L, T, _>(&mut self.row_good, &ctx, forced);
+                run_rows::<L, T, _, P>(&mut self.row_good, &ctx, forced);
             }
         }
         std::mem::swap(&mut fluid.f, &mut self.other);

@@ -11,7 +11,8 @@
 
 use crate::LbmError;
 use crate::bingham::{Bingham, BinghamRates};
-use crate::collision::{CollideParams, LocalRates, NodeRates};
+use crate::collision::{CollideParams, Collider, LocalRates, NodeRates};
+use crate::compiled::Place;
 use crate::diagnosis::BadNode;
 use crate::domain::{Face, Motion};
 use crate::kernel::{MacroOut, SyncPtr};
@@ -64,23 +65,17 @@ pub struct StepperAa<L, T: Real, St: Storage<T> = T> {
     _l: PhantomData<L>,
 }
 
-/// Every row of one AA step with the collision `C`, spread over the pool by `partition`.
-fn run_rows_aa<L: Lattice, T: Real, St: Storage<T>, C: crate::collision::Collider<L, T>>(
+/// Every row of one AA step with the collision `C`, spread over the pool by `partition`. The
+/// tasks run `P::rows_aa` (`compiled::Place`: the codegen unit the kernel copies go to).
+fn run_rows_aa<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, P: Place>(
     bad: &mut [Bad],
     ctx: &CtxAa<T, C, St>,
     partition: Partition,
     odd: bool,
     forced: bool,
 ) {
-    // One kernel variant per dispatched copy: a copy holding all four ran f32 9 % slower.
     let work = |(c, flags): (usize, &mut [Bad]), rows: usize| {
-        let first = c * rows;
-        match (odd, forced) {
-            (true, true) => simd::dispatch(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags)),
-            (true, false) => simd::dispatch(RowsAa::<L, T, St, C, true, false>::new(ctx, first, flags)),
-            (false, true) => simd::dispatch(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags)),
-            (false, false) => simd::dispatch(RowsAa::<L, T, St, C, false, false>::new(ctx, first, flags)),
-        }
+        P::rows_aa::<L, T, St, C>(ctx, c * rows, flags, odd, forced)
     };
     match partition {
         Partition::Rows(k) => {
@@ -93,6 +88,34 @@ fn run_rows_aa<L: Lattice, T: Real, St: Storage<T>, C: crate::collision::Collide
                 .with_max_len(1)
                 .enumerate()
                 .for_each(|t| work(t, k));
+        }
+    }
+}
+
+/// One task's rows of an AA step, from row `first` (odd or even, forced or not): the body of
+/// `Place::rows_aa`. One kernel variant per dispatched copy: a copy holding all four ran f32 9 %
+/// slower. The per-node colliders (`Collider::FORCE_TERMS_ALWAYS`) are compiled with the force
+/// terms only, so half as many copies of them are built.
+#[inline(always)]
+pub(crate) fn rows_aa<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>>(
+    ctx: &CtxAa<T, C, St>,
+    first: usize,
+    flags: &mut [Bad],
+    odd: bool,
+    forced: bool,
+) {
+    if C::FORCE_TERMS_ALWAYS {
+        if odd {
+            simd::dispatch(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags))
+        } else {
+            simd::dispatch(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags))
+        }
+    } else {
+        match (odd, forced) {
+            (true, true) => simd::dispatch(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags)),
+            (true, false) => simd::dispatch(RowsAa::<L, T, St, C, true, false>::new(ctx, first, flags)),
+            (false, true) => simd::dispatch(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags)),
+            (false, false) => simd::dispatch(RowsAa::<L, T, St, C, false, false>::new(ctx, first, flags)),
         }
     }
 }
@@ -117,8 +140,8 @@ impl<'a, L, T, St, C, const ODD: bool, const F: bool> RowsAa<'a, L, T, St, C, OD
     }
 }
 
-impl<L: Lattice, T: Real, St: Storage<T>, C: crate::collision::Collider<L, T>, const ODD: bool, const F: bool>
-    WithSimd for RowsAa<'_, L, T, St, C, ODD, F>
+impl<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const ODD: bool, const F: bool> WithSimd
+    for RowsAa<'_, L, T, St, C, ODD, F>
 {
     type Output = ();
     #[inline(always)]
@@ -341,7 +364,7 @@ impl<L: Lattice, T: Real, St: Storage<T>> StepperAa<L, T, St> {
     }
 
     /// The body of [`StepperAa::step`], instantiated by `compiled` only.
-    pub(crate) fn step_generic(
+    pub(crate) fn step_generic<P: Place>(
         &mut self,
         fluid: &mut Fluid<L, T>,
         out: Option<&mut Macro>,
@@ -395,7 +418,7 @@ impl<L: Lattice, T: Real, St: Storage<T>> StepperAa<L, T, St> {
                 limits,
                 out,
             };
-            run_rows_aa::<L, T, St, _>(&mut self.bad, &ctx, partition, odd, forced);
+            run_rows_aa::<L, T, St, _, P>(&mut self.bad, &ctx, partition, odd, forced);
         } else {
             match (&self.bingham, &self.local) {
                 (Some((_, rates)), _) => {
@@ -412,7 +435,7 @@ impl<L: Lattice, T: Real, St: Storage<T>> StepperAa<L, T, St> {
                         limits,
                         out,
                     };
-                    run_rows_aa::<L, T, St, _>(&mut self.bad, &ctx, partition, odd, forced);
+                    run_rows_aa::<L, T, St, _, P>(&mut self.bad, &ctx, partition, odd, forced);
                 }
                 (None, Some((rates, _))) => {
                     let ctx = CtxAa {
@@ -429,7 +452,7 @@ impl<L: Lattice, T: Real, St: Storage<T>> StepperAa<L, T, St> {
                         limits,
                         out,
                     };
-                    run_rows_aa::<L, T, St, _>(&mut self.bad, &ctx, partition, odd, forced);
+                    run_rows_aa::<L, T, St, _, P>(&mut self.bad, &ctx, partition, odd, forced);
                 }
                 (None, None) => unreachable!("the uniform arm above"),
             }
