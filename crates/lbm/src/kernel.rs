@@ -31,10 +31,21 @@ pub const fn wide<T>() -> usize {
 /// copies were half this crate's machine code (7.3 of 15 MB, mostly spills of 32-node blocks
 /// into 16 SSE registers) and the largest part of its build time, for a path only CPUs without
 /// AVX2 take.
+///
+/// A lattice of more than nine directions (D3Q19) takes one register per quantity where the copy
+/// has 256-bit vectors or wider: 19 populations of two or four registers each do not fit 16 AVX2
+/// (or 32 AVX-512) registers, and the spills made D3Q19 compute-bound at 17-25 % of its bound
+/// (docs/lbm.md, "D3Q19's block width").
 #[inline(always)]
-pub const fn block_width<T, S: Simd>() -> usize {
-    let reg = std::mem::size_of::<S::f32s>();
-    if NATIVE_V4 || reg >= 64 {
+pub const fn block_width<T, S: Simd>(q: usize) -> usize {
+    let reg = if NATIVE_V4 {
+        64
+    } else {
+        std::mem::size_of::<S::f32s>()
+    };
+    if q > 9 && reg >= 32 {
+        reg / std::mem::size_of::<T>()
+    } else if reg >= 64 {
         wide::<T>()
     } else if reg >= 32 && std::mem::size_of::<T>() == 8 {
         // AVX2 f64: four registers per quantity, as with AVX-512; two ran at half the rate
@@ -45,18 +56,18 @@ pub const fn block_width<T, S: Simd>() -> usize {
     }
 }
 
-/// Evaluate `$call` with the constant `$wb` = [`block_width`]`::<T, S>()` in scope (it names the
+/// Evaluate `$call` with the constant `$wb` = [`block_width`]`::<T, S>(L::Q)` in scope (it names the
 /// kernel's block width, e.g. `run_w::<L, T, C, F, WB>`). The branches are resolved before LLVM
 /// (`const { }`), so each copy holds the kernel at its own width only.
 macro_rules! at_block_width {
-    ($t:ty, $s:ty, $wb:ident => $call:expr) => {
-        if const { $crate::kernel::block_width::<$t, $s>() == 32 } {
+    ($l:ty, $t:ty, $s:ty, $wb:ident => $call:expr) => {
+        if const { $crate::kernel::block_width::<$t, $s>(<$l as $crate::lattice::Lattice>::Q) == 32 } {
             const $wb: usize = 32;
             $call
-        } else if const { $crate::kernel::block_width::<$t, $s>() == 16 } {
+        } else if const { $crate::kernel::block_width::<$t, $s>(<$l as $crate::lattice::Lattice>::Q) == 16 } {
             const $wb: usize = 16;
             $call
-        } else if const { $crate::kernel::block_width::<$t, $s>() == 8 } {
+        } else if const { $crate::kernel::block_width::<$t, $s>(<$l as $crate::lattice::Lattice>::Q) == 8 } {
             const $wb: usize = 8;
             $call
         } else {
@@ -217,7 +228,7 @@ pub unsafe fn row<L: Lattice, T: Real, C: Collider<L, T>, const F: bool, S: Simd
     }
     for &(x0, x1) in &plan.spans[plan.span_start[r] as usize..plan.span_start[r + 1] as usize] {
         good &= unsafe {
-            at_block_width!(T, S, WB => span::<L, T, C, F, WB>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off))
+            at_block_width!(L, T, S, WB => span::<L, T, C, F, WB>(ctx, &src, &dst, x0 as usize, x1 as usize, row_off))
         };
     }
     // periodic x edges with only fluid neighbours: the fast path with a wrapped x

@@ -141,7 +141,7 @@ unsafe fn block<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const B:
     check::<T, C, St, B>(ctx, &m, node, bad);
 }
 
-/// Nodes [x0, x1) of a row in blocks of `kernel::block_width::<T, S>()` nodes (two AVX-512
+/// Nodes [x0, x1) of a row in blocks of `kernel::block_width::<T, S>(L::Q)` nodes (two AVX-512
 /// registers per quantity where the copy has 256-bit vectors or wider), the rest in one block each
 /// of 16, 8, 4, 2 and 1 nodes at most (narrower vectors instead of up to 31 scalar nodes).
 ///
@@ -157,7 +157,9 @@ unsafe fn run<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const F: b
     node_off: usize,
     bad: &mut Bad,
 ) {
-    unsafe { at_block_width!(T, S, WB => run_w::<L, T, St, C, F, WB>(ctx, src, dst, x0, x1, node_off, bad)) }
+    unsafe {
+        at_block_width!(L, T, S, WB => run_w::<L, T, St, C, F, WB>(ctx, src, dst, x0, x1, node_off, bad))
+    }
 }
 
 #[inline(always)]
