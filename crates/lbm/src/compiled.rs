@@ -90,6 +90,18 @@ pub(crate) trait Place {
     }
 }
 
+/// One module per name, each holding a [`Place`] marker `Here`.
+macro_rules! places {
+    ($($step:ident),*) => {
+        $(
+            pub mod $step {
+                pub struct Here;
+                impl crate::compiled::Place for Here {}
+            }
+        )*
+    };
+}
+
 /// `impl Compiled for $lattice`: each method calls the generic step of its stepper, so that the
 /// variants are compiled here (not `#[inline]`: inlining would copy them into the caller). In
 /// this crate's own unit-test build they are `#[inline]`, so that it compiles only the variants
@@ -98,30 +110,7 @@ macro_rules! compiled {
     ($lattice:ty, $m:ident) => {
         /// The [`Place`] markers of this lattice's steps, a module each (one codegen unit each).
         mod $m {
-            pub mod two_f64 {
-                pub struct Here;
-                impl crate::compiled::Place for Here {}
-            }
-            pub mod two_f32 {
-                pub struct Here;
-                impl crate::compiled::Place for Here {}
-            }
-            pub mod aa_f64 {
-                pub struct Here;
-                impl crate::compiled::Place for Here {}
-            }
-            pub mod aa_f32 {
-                pub struct Here;
-                impl crate::compiled::Place for Here {}
-            }
-            pub mod aa_f32s {
-                pub struct Here;
-                impl crate::compiled::Place for Here {}
-            }
-            pub mod aa_f16s {
-                pub struct Here;
-                impl crate::compiled::Place for Here {}
-            }
+            places!(two_f64, two_f32, aa_f64, aa_f32, aa_f32s, aa_f16s);
         }
 
         impl Compiled for $lattice {

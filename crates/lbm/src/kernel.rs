@@ -34,8 +34,8 @@ pub const fn wide<T>() -> usize {
 ///
 /// A lattice of more than nine directions (D3Q19) takes one register per quantity where the copy
 /// has 256-bit vectors or wider: 19 populations of two or four registers each do not fit 16 AVX2
-/// (or 32 AVX-512) registers, and the spills made D3Q19 compute-bound at 17-25 % of its bound
-/// (docs/lbm.md, "D3Q19's block width").
+/// (or 32 AVX-512) registers; the spills held D3Q19 at 17-45 % of its bound (docs/lbm.md,
+/// "D3Q19's block width").
 #[inline(always)]
 pub const fn block_width<T, S: Simd>(q: usize) -> usize {
     let reg = if NATIVE_V4 {

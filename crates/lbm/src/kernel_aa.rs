@@ -141,8 +141,8 @@ unsafe fn block<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>, const B:
     check::<T, C, St, B>(ctx, &m, node, bad);
 }
 
-/// Nodes [x0, x1) of a row in blocks of `kernel::block_width::<T, S>(L::Q)` nodes (two AVX-512
-/// registers per quantity where the copy has 256-bit vectors or wider), the rest in one block each
+/// Nodes [x0, x1) of a row in blocks of `kernel::block_width::<T, S>(L::Q)` nodes (one to four
+/// registers per quantity, by lattice and level), the rest in one block each
 /// of 16, 8, 4, 2 and 1 nodes at most (narrower vectors instead of up to 31 scalar nodes).
 ///
 /// # Safety
