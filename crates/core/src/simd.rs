@@ -129,6 +129,36 @@ pub fn dispatch<Op: WithSimd>(op: Op) -> Op::Output {
     arch().dispatch(op)
 }
 
+/// As [`dispatch`], but where the level taken is v3 and the CPU also has F16C, `op` runs in a copy
+/// compiled with F16C as well, so that half-precision conversions (`#[target_feature(enable =
+/// "f16c")]` and `#[inline]`) inline into it: pulp's v3 level leaves F16C out, and a call per
+/// block of nodes cost the binary16 LBM storage a third of its time (docs/lbm.md, "Binary16
+/// conversions inlined"). The other levels are [`dispatch`]'s. Same bits: the conversions are
+/// the same instructions, inlined or not.
+#[inline(always)]
+pub fn dispatch_f16c<Op: WithSimd>(op: Op) -> Op::Output {
+    #[cfg(target_arch = "x86_64")]
+    if !NATIVE_V4
+        && let Arch::V3(v3) = arch()
+        && std::arch::is_x86_feature_detected!("f16c")
+    {
+        // SAFETY: the V3 token proves pulp's v3 features, and F16C was just detected.
+        return unsafe { v3_f16c(v3, op) };
+    }
+    dispatch(op)
+}
+
+/// `op` in a copy compiled for pulp's v3 features and F16C ([`dispatch_f16c`]).
+///
+/// # Safety
+/// The CPU has every feature enabled here.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "sse3,ssse3,sse4.1,sse4.2,popcnt,avx,avx2,bmi1,bmi2,fma,lzcnt,f16c")]
+#[inline]
+unsafe fn v3_f16c<Op: WithSimd>(v3: pulp::x86::V3, op: Op) -> Op::Output {
+    op.with_simd(v3)
+}
+
 /// Inside an op run by [`dispatch`]: whether this copy (`S`) runs with AVX-512 (the v4 copy,
 /// or any copy of a build for an AVX-512 CPU), so it may take hand-written AVX-512 code. A
 /// constant in each copy: the other branch is not compiled into it.

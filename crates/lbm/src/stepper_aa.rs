@@ -106,17 +106,29 @@ pub(crate) fn rows_aa<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>>(
 ) {
     if C::FORCE_TERMS_ALWAYS {
         if odd {
-            simd::dispatch(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags))
+            run_copy::<T, St, _>(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags))
         } else {
-            simd::dispatch(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags))
+            run_copy::<T, St, _>(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags))
         }
     } else {
         match (odd, forced) {
-            (true, true) => simd::dispatch(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags)),
-            (true, false) => simd::dispatch(RowsAa::<L, T, St, C, true, false>::new(ctx, first, flags)),
-            (false, true) => simd::dispatch(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags)),
-            (false, false) => simd::dispatch(RowsAa::<L, T, St, C, false, false>::new(ctx, first, flags)),
+            (true, true) => run_copy::<T, St, _>(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags)),
+            (true, false) => run_copy::<T, St, _>(RowsAa::<L, T, St, C, true, false>::new(ctx, first, flags)),
+            (false, true) => run_copy::<T, St, _>(RowsAa::<L, T, St, C, false, true>::new(ctx, first, flags)),
+            (false, false) => {
+                run_copy::<T, St, _>(RowsAa::<L, T, St, C, false, false>::new(ctx, first, flags))
+            }
         }
+    }
+}
+
+/// `op` through the storage's dispatch: with F16C for the binary16 storage (`Storage::F16C`).
+#[inline(always)]
+fn run_copy<T: Real, St: Storage<T>, Op: WithSimd>(op: Op) -> Op::Output {
+    if St::F16C {
+        simd::dispatch_f16c(op)
+    } else {
+        simd::dispatch(op)
     }
 }
 

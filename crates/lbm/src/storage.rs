@@ -28,6 +28,9 @@ pub trait Storage<T: Real>: Copy + Send + Sync + Default + std::fmt::Debug + 'st
     const NAME: &'static str;
     /// Whether the stored value is f_i − w_i (false: f_i itself).
     const SHIFTED: bool;
+    /// Whether the kernels run in copies compiled with F16C where the CPU has it
+    /// (`lbdem_core::simd::dispatch_f16c`), so that this storage's conversions inline.
+    const F16C: bool = false;
     /// The stored form of `v` (already shifted when `SHIFTED`), rounded to nearest.
     fn encode(v: T) -> Self;
     /// The value in the arithmetic type (still shifted when `SHIFTED`).
@@ -242,6 +245,7 @@ impl ShiftedF16 {
 impl Storage<f32> for ShiftedF16 {
     const NAME: &'static str = "f16s";
     const SHIFTED: bool = true;
+    const F16C: bool = true;
     #[inline(always)]
     fn encode(v: f32) -> Self {
         ShiftedF16(half::f16::from_f32(v))
@@ -300,10 +304,11 @@ impl Storage<f32> for ShiftedF16 {
     }
 }
 
-/// Whole-block conversions with the F16C instructions (8 values per instruction). They sit out of
-/// line, one call per block of nodes for all Q directions: the kernels' instruction-set copies
-/// (`lbdem_core::simd`, pulp's x86-64-v3 level) do not enable F16C, so the instructions cannot be
-/// inlined into them, and a call per direction would cost more than the conversions.
+/// Whole-block conversions with the F16C instructions (8 values per instruction), a block of nodes
+/// for all Q directions at a time. pulp's x86-64-v3 level does not enable F16C, so this storage's
+/// kernels run in a v3 copy compiled with F16C as well (`Storage::F16C`,
+/// `lbdem_core::simd::dispatch_f16c`; AVX-512 implies F16C) and these inline into it; from the
+/// portable copy they are a call per block.
 #[cfg(target_arch = "x86_64")]
 mod f16c {
     use crate::lattice::{Lattice, QMAX};
@@ -319,6 +324,7 @@ mod f16c {
     /// # Safety
     /// F16C and AVX present; `B` a multiple of 8; reads in bounds.
     #[target_feature(enable = "avx,f16c")]
+    #[inline]
     pub(super) unsafe fn gather<L: Lattice, const B: usize>(
         f: *const u16,
         src: &[usize; QMAX],
@@ -342,6 +348,7 @@ mod f16c {
     /// # Safety
     /// F16C and AVX present; `B` a multiple of 8; writes in bounds and unshared.
     #[target_feature(enable = "avx,f16c")]
+    #[inline]
     pub(super) unsafe fn scatter<L: Lattice, const B: usize>(
         f: *mut u16,
         dst: &[usize; QMAX],
