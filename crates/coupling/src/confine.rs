@@ -352,7 +352,7 @@ impl Confinement {
             return;
         }
         let scale = 1.0 - injected / mass;
-        fluid.set_pull_scale(scale);
+        fluid.set_pull_scale(scale, mass);
         let rho_ref = mass / nodes as f64;
         for (e, x) in self.edge_nodes.iter().zip(&ex) {
             let p = x.momentum(scale, rho_ref);

@@ -543,11 +543,14 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
 
     /// Multiply every population the next step pulls by `scale` (then back to 1): takes the
     /// mass (1 − s) M out of the liquid in proportion to each node's, leaving its velocity as
-    /// it is. Counted in [`ZoneMass::rescaled`].
-    pub fn set_pull_scale(&mut self, scale: f64) {
+    /// it is. Counted in [`ZoneMass::rescaled`]. `liquid_mass` is M, `liquid_mass_nodes().0` of
+    /// the state as it is: the caller has it already (`Confinement::membrane_reaction` needs it
+    /// for `scale`), and the sum over every node is not done twice per LBM step.
+    pub fn set_pull_scale(&mut self, scale: f64, liquid_mass: f64) {
+        debug_assert_eq!(liquid_mass.to_bits(), self.liquid_mass_nodes().0.to_bits());
         // Every population of an active node is pulled once in the step (by its neighbour, or
         // by itself through a bounce-back link), so the step takes (1 − s) of the mass.
-        self.zone_mass.rescaled += (1.0 - scale) * self.liquid_mass_nodes().0;
+        self.zone_mass.rescaled += (1.0 - scale) * liquid_mass;
         self.pull_scale = scale;
     }
 

@@ -212,7 +212,7 @@ fn what_the_zone_exchanges_is_what_the_liquid_gains_in_the_step() {
             p[1] += q[1];
         }
         let removed = f.zone_mass().rescaled;
-        f.set_pull_scale(scale);
+        f.set_pull_scale(scale, f.liquid_mass_nodes().0);
         assert_eq!(
             f.zone_mass().rescaled - removed,
             (1.0 - scale) * f.liquid_mass_nodes().0
