@@ -104,6 +104,8 @@ pub(crate) fn rows_aa<L: Lattice, T: Real, St: Storage<T>, C: Collider<L, T>>(
     odd: bool,
     forced: bool,
 ) {
+    // The constant is tested on its own (not `forced || C::FORCE_TERMS_ALWAYS`) so that rustc
+    // drops the arms a collider cannot take before it compiles them.
     if C::FORCE_TERMS_ALWAYS {
         if odd {
             run_copy::<T, St, _>(RowsAa::<L, T, St, C, true, true>::new(ctx, first, flags))
