@@ -50,6 +50,8 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::settling_study::SettlingStudy>(&["settling-study"], CliShape::ParamsFile),
     entry::<stages::stability_map::StabilityMap>(&["stability-map"], CliShape::ParamsFile),
     entry::<stages::stability_map::dem::DemStepMap>(&["dem-step-map"], CliShape::ParamsFile),
+    entry::<stages::stability_map::bingham::BinghamMap>(&["bingham-map"], CliShape::ParamsFile),
+    entry::<stages::stability_map::free_surface::FreeSurfaceMap>(&["free-surface-map"], CliShape::ParamsFile),
     entry::<stages::report::Report>(&["report"], CliShape::ParamsFile),
     entry::<stages::analyse::Analyse>(&["analyse"], CliShape::ParamsFile),
     entry::<stages::synth_run::SynthRun>(&["synth", "run"], CliShape::ParamsFile),

@@ -11,206 +11,8 @@
 #![allow(clippy::needless_range_loop)]
 use crate::common;
 use common::*;
-use lbdem_lbm::{
-    Bingham, Collision, D2Q9, D3Q19, Domain, Face, Fluid, Lattice, LbmError, Macro, Real, Stepper, StepperAa,
-};
-
-/// One Bingham channel case: `h_nodes` fluid rows between halfway bounce-back walls (half-width
-/// h = h_nodes/2), plastic viscosity from τ_pl, plug half-width `y0_frac` h, plug velocity `u_p`.
-#[derive(Clone, Copy, Debug)]
-struct Case {
-    h_nodes: usize,
-    tau_pl: f64,
-    tau_max: f64,
-    y0_frac: f64,
-    u_p: f64,
-}
-
-impl Case {
-    fn h(&self) -> f64 {
-        self.h_nodes as f64 / 2.0
-    }
-    fn mu_pl(&self) -> f64 {
-        (self.tau_pl - 0.5) / 3.0
-    }
-    fn y0(&self) -> f64 {
-        self.y0_frac * self.h()
-    }
-    /// Force density from u_p = G (h − y₀)² / (2 μ_pl).
-    fn g(&self) -> f64 {
-        2.0 * self.mu_pl() * self.u_p / (self.h() - self.y0()).powi(2)
-    }
-    fn yield_stress(&self) -> f64 {
-        self.y0() * self.g()
-    }
-    fn bingham(&self) -> Bingham {
-        Bingham {
-            mu_pl: self.mu_pl(),
-            yield_stress: self.yield_stress(),
-            rho: 1.0,
-            tau_min: 0.501,
-            tau_max: self.tau_max,
-        }
-    }
-    /// Distance of row y from the channel centre (walls at y = −½ and h_nodes − ½).
-    fn yc(&self, y: usize) -> f64 {
-        y as f64 + 0.5 - self.h()
-    }
-    /// The analytic Bingham profile (module doc).
-    fn bingham_u(&self, y: f64) -> f64 {
-        let (h, y0, g, mu) = (self.h(), self.y0(), self.g(), self.mu_pl());
-        let a = y.abs().max(y0);
-        g * ((h * h - a * a) - 2.0 * y0 * (h - a)) / (2.0 * mu)
-    }
-    /// Exact profile of the clamped law (Fig. 4): u(y) = ∫_|y|^h γ̇(G s) ds with γ̇(σ) = σ/μ_max
-    /// below σ_c = σ_y μ_max/(μ_max − μ_pl), (σ − σ_y)/μ_pl above it, σ/μ_min above
-    /// σ_d = σ_y μ_min/(μ_min − μ_pl) when μ_min > μ_pl. γ̇ is piecewise linear in s and
-    /// continuous, so the trapezoid rule between the break points is exact.
-    fn clamped_u(&self, y: f64) -> f64 {
-        let b = self.bingham();
-        let (mu_pl, sy, g) = (self.mu_pl(), self.yield_stress(), self.g());
-        let mu_max = (b.tau_max - 0.5) / 3.0;
-        let mu_min = (b.tau_min - 0.5) / 3.0;
-        let s_c = sy * mu_max / (mu_max - mu_pl) / g;
-        let s_d = if mu_min > mu_pl {
-            sy * mu_min / (mu_min - mu_pl) / g
-        } else {
-            f64::INFINITY
-        };
-        let rate = |s: f64| {
-            let sigma = g * s;
-            if s <= s_c {
-                sigma / mu_max
-            } else if s <= s_d {
-                (sigma - sy) / mu_pl
-            } else {
-                sigma / mu_min
-            }
-        };
-        let mut pts = vec![y.abs(), self.h()];
-        for s in [s_c, s_d] {
-            if s > y.abs() && s < self.h() {
-                pts.push(s);
-            }
-        }
-        pts.sort_by(f64::total_cmp);
-        pts.windows(2)
-            .map(|w| (w[1] - w[0]) * 0.5 * (rate(w[0]) + rate(w[1])))
-            .sum()
-    }
-    /// Half-width of the clamped core, y_c = y₀ μ_max/(μ_max − μ_pl) (module doc of `bingham`).
-    fn y_c(&self) -> f64 {
-        let mu_max = (self.tau_max - 0.5) / 3.0;
-        self.y0() * mu_max / (mu_max - self.mu_pl())
-    }
-}
-
-/// Result of one channel run.
-#[derive(Debug)]
-struct Outcome {
-    /// u per row (x = 0).
-    u: Vec<f64>,
-    /// τ per row from the kernel (`bingham_tau`).
-    tau: Vec<f64>,
-    steps: usize,
-}
-
-fn walls_3d(n: [usize; 3]) -> Domain {
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    Domain::new(
-        n,
-        [
-            Face::Periodic,
-            Face::Periodic,
-            wall,
-            wall,
-            Face::Periodic,
-            Face::Periodic,
-        ],
-    )
-}
-
-/// Run the channel on the AA stepper (the default kernel) from rest to a steady state: the
-/// largest change of u over 1000 steps below 1e-11 u_p.
-fn run_channel<L: Lattice>(case: &Case, collision: Collision, nx: usize, nz: usize) -> Outcome {
-    let dom = if L::D == 2 {
-        channel(nx, case.h_nodes)
-    } else {
-        walls_3d([nx, case.h_nodes, nz])
-    };
-    let mut fl = Fluid::<L, f64>::new(dom, Vec::new());
-    let mut st = StepperAa::new(&mut fl, settings(collision, [case.g(), 0.0, 0.0])).unwrap();
-    st.set_bingham(Some(case.bingham())).unwrap();
-    let mut m = Macro::default();
-    let mut prev: Vec<f64> = Vec::new();
-    let mut steps = 0;
-    let every = 1000;
-    loop {
-        for k in 0..every {
-            st.step(&mut fl, if k + 1 == every { Some(&mut m) } else { None })
-                .unwrap();
-        }
-        steps += every;
-        if !prev.is_empty() {
-            let d =
-                m.u.iter()
-                    .zip(&prev)
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0, f64::max);
-            if d < 1e-11 * case.u_p || steps >= 400_000 {
-                break;
-            }
-        }
-        prev.clone_from(&m.u);
-    }
-    let tau_all = st.bingham_tau().unwrap();
-    let row = |y: usize| y * nx;
-    Outcome {
-        u: (0..case.h_nodes).map(|y| m.u[3 * row(y)]).collect(),
-        tau: (0..case.h_nodes).map(|y| tau_all[row(y)]).collect(),
-        steps,
-    }
-}
-
-/// The figures of one run against the analytic profiles.
-#[derive(Debug)]
-struct Errors {
-    /// |u_num − u_p| / u_p at the row next to the centre (Bingham plug velocity).
-    plug: f64,
-    /// L2 error of the profile against the Bingham profile, relative to its L2 norm.
-    l2: f64,
-    /// The same two against the exact clamped (tri-viscosity) profile: the lattice's own error.
-    plug_clamped: f64,
-    l2_clamped: f64,
-    /// Rows with τ = τ_max (the clamped core) and the count the clamped law predicts.
-    core_rows: usize,
-    core_rows_exact: usize,
-}
-
-fn errors(case: &Case, out: &Outcome) -> Errors {
-    let n = case.h_nodes;
-    let mid = n / 2; // the row at y_c = +½
-    let u_p = case.u_p;
-    let l2 = |exact: &dyn Fn(f64) -> f64| {
-        let (mut e, mut s) = (0.0, 0.0);
-        for y in 0..n {
-            let want = exact(case.yc(y));
-            e += (out.u[y] - want).powi(2);
-            s += want * want;
-        }
-        (e / s).sqrt()
-    };
-    let core_rows = out.tau.iter().filter(|&&t| t == case.tau_max).count();
-    let core_rows_exact = (0..n).filter(|&y| case.yc(y).abs() < case.y_c()).count();
-    Errors {
-        plug: (out.u[mid] - u_p).abs() / u_p,
-        l2: l2(&|y| case.bingham_u(y)),
-        plug_clamped: (out.u[mid] - case.clamped_u(case.yc(mid))).abs() / u_p,
-        l2_clamped: l2(&|y| case.clamped_u(y)),
-        core_rows,
-        core_rows_exact,
-    }
-}
+use lbdem_lbm::cases::bingham_poiseuille::{Case, errors, run_channel};
+use lbdem_lbm::{Bingham, Collision, D2Q9, D3Q19, Fluid, Lattice, LbmError, Macro, Real, Stepper, StepperAa};
 
 const TRT: Collision = Collision::Trt {
     tau: 0.65,
@@ -221,6 +23,7 @@ fn case(y0_frac: f64, tau_max: f64) -> Case {
     Case {
         h_nodes: 32,
         tau_pl: 0.65,
+        tau_min: 0.501,
         tau_max,
         y0_frac,
         u_p: 0.02,
@@ -256,8 +59,8 @@ fn bingham_poiseuille_matches_the_analytic_profile() {
     let mut plug = Vec::new();
     for (y0, tau_max, tol_plug, tol_l2, tol_l2c) in table {
         let c = case(y0, tau_max);
-        let out = run_channel::<D2Q9>(&c, TRT, 4, 1);
-        let e = errors(&c, &out);
+        let out = run_channel::<D2Q9>(&c, TRT, 4, 1, 400_000).unwrap();
+        let e = errors(&c, &out).unwrap();
         eprintln!(
             "y0/h {y0} tau_max {tau_max}: G {:.4e} sigma_y {:.4e} steps {} | vs Bingham: plug {:.3e} L2 {:.3e} | \
              vs clamped law: plug {:.3e} L2 {:.3e} | core rows {} (clamped law {}, Bingham 2y0 = {:.2}, 2y_c = {:.2})",
@@ -296,8 +99,8 @@ fn bingham_poiseuille_matches_the_analytic_profile() {
 #[test]
 fn bingham_poiseuille_d3q19() {
     let c = case(0.25, 3.5);
-    let out = run_channel::<D3Q19>(&c, TRT, 4, 3);
-    let e = errors(&c, &out);
+    let out = run_channel::<D3Q19>(&c, TRT, 4, 3, 400_000).unwrap();
+    let e = errors(&c, &out).unwrap();
     eprintln!("D3Q19 y0/h 0.25 tau_max 3.5: steps {} {e:?}", out.steps);
     assert!(e.plug < 1.1e-2 && e.l2 < 5.4e-3 && e.l2_clamped < 1.9e-3, "{e:?}");
     assert_eq!(e.core_rows, e.core_rows_exact, "{e:?}");

@@ -5,7 +5,9 @@
 //! (`lbdem_core::units::lattice::LatticeUnits::derive`) is asked what it would say of the same
 //! setting. Writes the CSV and one PNG map per collision; `docs/stability.md` reads them.
 
+pub mod bingham;
 pub mod dem;
+pub mod free_surface;
 pub mod lbm;
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
@@ -13,7 +15,7 @@ use crate::report::grid_map::{Cell, GridMap, Mark, grid_map_png};
 use crate::report::table::{Col, write_table};
 use anyhow::{Result, bail};
 use lbdem_core::units::lattice::{CS2, U_MAX};
-use lbdem_lbm::cases::taylor_green;
+use lbdem_lbm::cases;
 use lbm::{Operator, Point};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -27,12 +29,12 @@ pub enum Verdict {
     Refused,
 }
 
-impl From<taylor_green::Verdict> for Verdict {
-    fn from(v: taylor_green::Verdict) -> Self {
+impl From<cases::Verdict> for Verdict {
+    fn from(v: cases::Verdict) -> Self {
         match v {
-            taylor_green::Verdict::Accepted => Verdict::Accepted,
-            taylor_green::Verdict::Warned(_) => Verdict::Warned,
-            taylor_green::Verdict::Refused(_) => Verdict::Refused,
+            cases::Verdict::Accepted => Verdict::Accepted,
+            cases::Verdict::Warned(_) => Verdict::Warned,
+            cases::Verdict::Refused(_) => Verdict::Refused,
         }
     }
 }

@@ -9,7 +9,6 @@
 //! have done.
 
 use crate::{Collision, D2Q9, Domain, Fluid, LbmError, Limits, Macro, Settings, Stepper};
-use lbdem_core::units::lattice::{LatticeInput, LatticeUnits, TimeSpec};
 use std::f64::consts::PI;
 
 /// One run: the collision, the velocity amplitude u0 (lattice units, Ma = u0/c_s) and the box.
@@ -46,23 +45,11 @@ pub struct Run {
     pub steps: u64,
 }
 
-/// What the set-up check scenes use (`LatticeUnits::derive`, lattice units dx = dt = ρ = 1,
-/// u_max = u0) says of a setting.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Verdict {
-    Accepted,
-    Warned(Vec<String>),
-    Refused(String),
-}
+pub use super::Verdict;
 
-/// The set-up check's verdict on `collision` at amplitude `u0`.
+/// The set-up check's verdict on `collision` at amplitude `u0` (u_max = u0).
 pub fn setup_verdict(collision: Collision, u0: f64) -> Verdict {
-    let inp = LatticeInput::new(1.0, collision.nu(), 1.0, u0, TimeSpec::Tau(collision.tau()));
-    match LatticeUnits::derive(&inp) {
-        Ok(u) if u.warnings.is_empty() => Verdict::Accepted,
-        Ok(u) => Verdict::Warned(u.warnings),
-        Err(e) => Verdict::Refused(e.to_string()),
-    }
+    super::setup_verdict(collision, u0)
 }
 
 /// Run the vortex. Errors are the engine's refusals at set-up (τ ≤ ½ unless forced); a run that
