@@ -1,11 +1,11 @@
 //! A compressed triangular packing of equal disks in a periodic box, undamped and frictionless
-//! under the linear law, set vibrating by small random velocities: its total energy (kinetic plus
-//! ½ k δ² per contact) is conserved by the exact dynamics, so the drift of the integrator's
-//! energy measures the step. Each disk is held by six contacts, the stiffest spring a grain of a
+//! under the linear law or Hertz's, set vibrating by small random velocities: its total energy
+//! (kinetic plus the elastic energy of each contact, ½ k δ² or (2/5) K δ^{5/2}) is conserved by
+//! the exact dynamics, so the drift of the integrator's energy measures the step. Each disk is held by six contacts, the stiffest spring a grain of a
 //! dense packing sees; the `dem-step-map` stage runs it beside the isolated pair
 //! ([`super::head_on`]) to show how far the critical step sqrt(m_min/k_max) holds in a packing.
 
-use crate::contact::LinearSpringDashpot;
+use crate::contact::{HertzMindlin, Law, LinearSpringDashpot};
 use crate::{Bodies, ClumpShape, Damping, DemError, Domain, StepParams, Stepper, System, Vec2, Vector};
 use rand::RngExt;
 
@@ -28,7 +28,34 @@ pub fn law(k: f64) -> LinearSpringDashpot {
     LinearSpringDashpot::new(k, 0.0, Damping::Ratio(0.0), 0.0)
 }
 
-fn energy(sys: &System, k: f64) -> f64 {
+/// Hertz's law of the case (Leonardi et al. 2014 Eq. 5), undamped and frictionless, with its
+/// tangent stiffness (3/2) K √δ at the lattice's overlap equal to `k` (N/m): Young's modulus
+/// from K = (2/3) Y √r_eff / (1 − ν²), ν = 0.3, r_eff = R/2. Its critical step is computed at
+/// the default largest overlap, 5 % of r_eff, a quarter above the lattice's 4 %.
+pub fn hertz(k: f64) -> HertzMindlin {
+    let (poisson, r_eff, delta) = (0.3, RADIUS / 2.0, COMPRESSION * 2.0 * RADIUS);
+    let prefactor = k / (1.5 * delta.sqrt());
+    HertzMindlin {
+        young: prefactor * 1.5 * (1.0 - poisson * poisson) / r_eff.sqrt(),
+        poisson,
+        a_damp: 0.0,
+        eta: 0.0,
+        mu: 0.0,
+        max_overlap: 0.05,
+    }
+}
+
+/// The elastic energy of a contact of overlap δ under `law` (linear or Hertz; the case builds no
+/// other).
+fn potential(law: &Law, delta: f64) -> f64 {
+    match law {
+        Law::Hertz(h) => 0.4 * h.prefactor(RADIUS / 2.0) * delta * delta * delta.sqrt(),
+        Law::Linear(l) => 0.5 * l.k_n * delta * delta,
+        _ => f64::NAN,
+    }
+}
+
+fn energy(sys: &System, law: &Law) -> f64 {
     let b = &sys.bodies;
     let kinetic: f64 = (0..b.len()).map(|i| 0.5 * b.mass[i] * b.vel[i].norm2()).sum();
     let mut elastic = 0.0;
@@ -36,16 +63,33 @@ fn energy(sys: &System, k: f64) -> f64 {
         for j in i + 1..b.len() {
             let overlap = 2.0 * RADIUS - sys.domain.min_image(b.pos[j] - b.pos[i]).norm();
             if overlap > 0.0 {
-                elastic += 0.5 * k * overlap * overlap;
+                elastic += potential(law, overlap);
             }
         }
     }
     kinetic + elastic
 }
 
-/// Run `nx` × `ny` disks (ny even) for `duration` critical steps at `ratio` × the critical step;
-/// `force` runs a step the stepper refuses. Errors are the stepper's set-up refusals.
+/// Run `nx` × `ny` disks (ny even) under the linear law of stiffness `k` for `duration` critical
+/// steps at `ratio` × the critical step; `force` runs a step the stepper refuses. Errors are the
+/// stepper's set-up refusals.
 pub fn run(
+    k: f64,
+    nx: usize,
+    ny: usize,
+    ratio: f64,
+    duration: f64,
+    force: bool,
+    seed: u64,
+) -> Result<Drift, DemError> {
+    run_law(&Law::Linear(law(k)), k, nx, ny, ratio, duration, force, seed)
+}
+
+/// [`run`] under `law` (linear or [`hertz`]), whose stiffness at the lattice's overlap is `k`
+/// (it sets the vibration's speed).
+#[allow(clippy::too_many_arguments)]
+pub fn run_law(
+    law: &Law,
     k: f64,
     nx: usize,
     ny: usize,
@@ -74,8 +118,7 @@ pub fn run(
         bodies,
         Domain::periodic(Vec2::ZERO, Vec2::new(nx as f64 * d, ny as f64 * h)),
     );
-    let law = law(k);
-    let (critical, _, _) = Stepper::critical_time_step(&sys, &law, &law);
+    let (critical, _, _) = Stepper::critical_time_step(&sys, law, law);
     let dt = ratio * critical;
     let p = StepParams::new(dt, 0.05);
     let mut st = if force {
@@ -86,11 +129,11 @@ pub fn run(
     let kinetic0: f64 = (0..sys.bodies.len())
         .map(|i| 0.5 * sys.bodies.mass[i] * sys.bodies.vel[i].norm2())
         .sum();
-    let e0 = energy(&sys, k);
+    let e0 = energy(&sys, law);
     let steps = (duration / ratio).ceil() as u64;
     let mut worst = 0.0f64;
     for step in 1..=steps {
-        match st.step(&p, &law, &law, &mut sys) {
+        match st.step(&p, law, law, &mut sys) {
             Ok(()) => {}
             Err(DemError::NonFinite { .. }) => {
                 return Ok(Drift {
@@ -101,7 +144,7 @@ pub fn run(
             }
             Err(e) => return Err(e),
         }
-        let e = (energy(&sys, k) - e0).abs() / kinetic0;
+        let e = (energy(&sys, law) - e0).abs() / kinetic0;
         worst = if e.is_finite() {
             worst.max(e)
         } else {
