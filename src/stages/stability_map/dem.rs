@@ -135,12 +135,12 @@ pub fn map(laws: &[Law], ratios: &[f64], speed: f64, accuracy: f64) -> Result<Ve
         }
     }
     let packings = [
-        (PACKING, Law::Linear(packing::law(PACKING_K))),
-        (PACKING_HERTZ, Law::Hertz(packing::hertz(PACKING_K))),
+        (PACKING, packing::PackingLaw::Linear),
+        (PACKING_HERTZ, packing::PackingLaw::Hertz),
     ];
     for (name, law) in &packings {
         for &ratio in ratios {
-            let d = packing::run_law(law, PACKING_K, 8, 8, ratio, 100.0, true, 1)
+            let d = packing::run_law(*law, PACKING_K, 8, 8, ratio, 100.0, true, 1)
                 .map_err(|e| anyhow!("dem-step-map: the {name} at dt/dt_crit = {ratio}: {e}"))?;
             let class = if d.energy_error > 100.0 {
                 Class::BlownUp

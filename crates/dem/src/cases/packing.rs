@@ -1,8 +1,8 @@
 //! A compressed triangular packing of equal disks in a periodic box, undamped and frictionless
 //! under the linear law or Hertz's, set vibrating by small random velocities: its total energy
 //! (kinetic plus the elastic energy of each contact, ½ k δ² or (2/5) K δ^{5/2}) is conserved by
-//! the exact dynamics, so the drift of the integrator's energy measures the step. Each disk is held by six contacts, the stiffest spring a grain of a
-//! dense packing sees; the `dem-step-map` stage runs it beside the isolated pair
+//! the exact dynamics, so the drift of the integrator's energy measures the step. Each disk is
+//! held by six contacts, the stiffest spring a grain of a dense packing sees; the `dem-step-map` stage runs it beside the isolated pair
 //! ([`super::head_on`]) to show how far the critical step sqrt(m_min/k_max) holds in a packing.
 
 use crate::contact::{HertzMindlin, Law, LinearSpringDashpot};
@@ -45,17 +45,34 @@ pub fn hertz(k: f64) -> HertzMindlin {
     }
 }
 
-/// The elastic energy of a contact of overlap δ under `law` (linear or Hertz; the case builds no
-/// other).
-fn potential(law: &Law, delta: f64) -> f64 {
-    match law {
-        Law::Hertz(h) => 0.4 * h.prefactor(RADIUS / 2.0) * delta * delta * delta.sqrt(),
-        Law::Linear(l) => 0.5 * l.k_n * delta * delta,
-        _ => f64::NAN,
+/// The laws whose energy the case conserves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PackingLaw {
+    /// [`law`]: ½ k δ² per contact.
+    Linear,
+    /// [`hertz`]: (2/5) K δ^{5/2} per contact.
+    Hertz,
+}
+
+impl PackingLaw {
+    /// The law of the case with tangent stiffness `k` at the lattice's overlap.
+    pub fn law(self, k: f64) -> Law {
+        match self {
+            PackingLaw::Linear => Law::Linear(law(k)),
+            PackingLaw::Hertz => Law::Hertz(hertz(k)),
+        }
+    }
+
+    /// The elastic energy of a contact of overlap δ.
+    fn potential(self, k: f64, delta: f64) -> f64 {
+        match self {
+            PackingLaw::Linear => 0.5 * k * delta * delta,
+            PackingLaw::Hertz => 0.4 * hertz(k).prefactor(RADIUS / 2.0) * delta * delta * delta.sqrt(),
+        }
     }
 }
 
-fn energy(sys: &System, law: &Law) -> f64 {
+fn energy(sys: &System, which: PackingLaw, k: f64) -> f64 {
     let b = &sys.bodies;
     let kinetic: f64 = (0..b.len()).map(|i| 0.5 * b.mass[i] * b.vel[i].norm2()).sum();
     let mut elastic = 0.0;
@@ -63,7 +80,7 @@ fn energy(sys: &System, law: &Law) -> f64 {
         for j in i + 1..b.len() {
             let overlap = 2.0 * RADIUS - sys.domain.min_image(b.pos[j] - b.pos[i]).norm();
             if overlap > 0.0 {
-                elastic += potential(law, overlap);
+                elastic += which.potential(k, overlap);
             }
         }
     }
@@ -82,14 +99,13 @@ pub fn run(
     force: bool,
     seed: u64,
 ) -> Result<Drift, DemError> {
-    run_law(&Law::Linear(law(k)), k, nx, ny, ratio, duration, force, seed)
+    run_law(PackingLaw::Linear, k, nx, ny, ratio, duration, force, seed)
 }
 
-/// [`run`] under `law` (linear or [`hertz`]), whose stiffness at the lattice's overlap is `k`
-/// (it sets the vibration's speed).
+/// [`run`] under `which` law, with tangent stiffness `k` at the lattice's overlap.
 #[allow(clippy::too_many_arguments)]
 pub fn run_law(
-    law: &Law,
+    which: PackingLaw,
     k: f64,
     nx: usize,
     ny: usize,
@@ -118,6 +134,7 @@ pub fn run_law(
         bodies,
         Domain::periodic(Vec2::ZERO, Vec2::new(nx as f64 * d, ny as f64 * h)),
     );
+    let law = &which.law(k);
     let (critical, _, _) = Stepper::critical_time_step(&sys, law, law);
     let dt = ratio * critical;
     let p = StepParams::new(dt, 0.05);
@@ -129,7 +146,7 @@ pub fn run_law(
     let kinetic0: f64 = (0..sys.bodies.len())
         .map(|i| 0.5 * sys.bodies.mass[i] * sys.bodies.vel[i].norm2())
         .sum();
-    let e0 = energy(&sys, law);
+    let e0 = energy(&sys, which, k);
     let steps = (duration / ratio).ceil() as u64;
     let mut worst = 0.0f64;
     for step in 1..=steps {
@@ -144,7 +161,7 @@ pub fn run_law(
             }
             Err(e) => return Err(e),
         }
-        let e = (energy(&sys, law) - e0).abs() / kinetic0;
+        let e = (energy(&sys, which, k) - e0).abs() / kinetic0;
         worst = if e.is_finite() {
             worst.max(e)
         } else {
