@@ -2,8 +2,9 @@
 //! under the linear law or Hertz's, set vibrating by small random velocities: its total energy
 //! (kinetic plus the elastic energy of each contact, ½ k δ² or (2/5) K δ^{5/2}) is conserved by
 //! the exact dynamics, so the drift of the integrator's energy measures the step. Each disk is
-//! held by six contacts, the stiffest spring a grain of a dense packing sees; the `dem-step-map` stage runs it beside the isolated pair
-//! ([`super::head_on`]) to show how far the critical step sqrt(m_min/k_max) holds in a packing.
+//! held by six contacts, the stiffest spring a grain of a dense packing sees; the `dem-step-map`
+//! stage runs it beside the isolated pair ([`super::head_on`]) to show how far the critical step
+//! sqrt(m_min/k_max) holds in a packing.
 
 use crate::contact::{HertzMindlin, Law, LinearSpringDashpot};
 use crate::{Bodies, ClumpShape, Damping, DemError, Domain, StepParams, Stepper, System, Vec2, Vector};
