@@ -10,8 +10,8 @@
 //! exact profile of the clamped law), which shows what part of the error is the clamp's.
 
 use super::lbm::Operator;
-use super::{Class, Verdict, draw_map};
-use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, Verdict, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput, Table};
 use crate::report::table::{Col, write_table};
 use anyhow::{Result, anyhow, bail};
 use lbdem_lbm::D2Q9;
@@ -240,29 +240,22 @@ impl Stage for BinghamMap {
         let points = pool.install(|| map(p))?;
         let csv = "bingham_map.csv";
         write_points(&ctx.out_dir.join(csv), &points)?;
-        let mut figures = Vec::new();
-        let mut files: Vec<PathBuf> = vec![csv.into()];
-        for &op in &p.operators {
-            let file = format!("bingham_map_{}.png", op.name().replace('/', "_"));
-            let cells = points.iter().filter(|q| q.operator == op).map(|q| {
-                let ix = p.tau_maxs.iter().position(|&t| t == q.tau_max).unwrap_or(0);
-                let iy = p.plugs.iter().position(|&y| y == q.plug).unwrap_or(0);
-                (ix, iy, q.class, q.verdict)
-            });
-            let x_ticks: Vec<String> = p.tau_maxs.iter().map(|t| format!("{t}")).collect();
-            let y_ticks: Vec<String> = p.plugs.iter().map(|y| format!("{y}")).collect();
-            draw_map(
-                &ctx.out_dir.join(&file),
-                cells,
-                &format!("Bingham Poiseuille, {}: plug width against tau_max", op.name()),
-                "upper clamp tau_max",
-                "plug half-width y0/h",
-                &x_ticks,
-                &y_ticks,
-            )?;
-            figures.push(Figure {
-                path: file.clone().into(),
-                caption: format!(
+        let grid = Grid {
+            xs: &p.tau_maxs,
+            ys: &p.plugs,
+            x_label: "upper clamp tau_max",
+            y_label: "plug half-width y0/h",
+        };
+        let (figures, mut files) = operator_maps(
+            &ctx.out_dir,
+            "bingham_map",
+            &p.operators,
+            &points,
+            |q| (q.operator, q.tau_max, q.plug, q.class, q.verdict),
+            &grid,
+            |op| format!("Bingham Poiseuille, {}: plug width against tau_max", op.name()),
+            |op| {
+                format!(
                     "{}: steady Bingham Poiseuille flow ({} rows, tau_pl {}, tau_min {}, plug speed {}) at each \
                      tau_max and plug half-width. Colour: accurate (L2 error against the Bingham profile below \
                      {} %), inaccurate, blown up. Mark: none if the checks accept, a ring if one warns, a \
@@ -273,10 +266,10 @@ impl Stage for BinghamMap {
                     p.tau_min,
                     p.u_p,
                     p.accuracy * 100.0
-                ),
-            });
-            files.push(file.into());
-        }
+                )
+            },
+        )?;
+        files.insert(0, csv.into());
         let disagree = points
             .iter()
             .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)

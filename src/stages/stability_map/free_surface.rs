@@ -9,8 +9,8 @@
 //! (`LatticeUnits::derive`, u_max = Ritter's speed) is asked what it says of the same setting.
 
 use super::lbm::Operator;
-use super::{Class, Verdict, draw_map};
-use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, Verdict, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput, Table};
 use crate::report::table::{Col, write_table};
 use anyhow::{Result, anyhow, bail};
 use lbdem_core::units::lattice::CS2;
@@ -184,29 +184,22 @@ impl Stage for FreeSurfaceMap {
         let points = pool.install(|| map(p))?;
         let csv = "free_surface_map.csv";
         write_points(&ctx.out_dir.join(csv), &points)?;
-        let mut figures = Vec::new();
-        let mut files: Vec<PathBuf> = vec![csv.into()];
-        for &op in &p.operators {
-            let file = format!("free_surface_map_{}.png", op.name().replace('/', "_"));
-            let cells = points.iter().filter(|q| q.operator == op).map(|q| {
-                let ix = p.machs.iter().position(|&m| m == q.mach).unwrap_or(0);
-                let iy = p.taus.iter().position(|&t| t == q.tau).unwrap_or(0);
-                (ix, iy, q.class, q.verdict)
-            });
-            let x_ticks: Vec<String> = p.machs.iter().map(|m| format!("{m}")).collect();
-            let y_ticks: Vec<String> = p.taus.iter().map(|t| format!("{t}")).collect();
-            draw_map(
-                &ctx.out_dir.join(&file),
-                cells,
-                &format!("Dam break, {}: tau against the front's Mach number", op.name()),
-                "Mach number of Ritter's front speed 2 sqrt(2 g a) / c_s",
-                "relaxation time tau",
-                &x_ticks,
-                &y_ticks,
-            )?;
-            figures.push(Figure {
-                path: file.clone().into(),
-                caption: format!(
+        let grid = Grid {
+            xs: &p.machs,
+            ys: &p.taus,
+            x_label: "Mach number of Ritter's front speed 2 sqrt(2 g a) / c_s",
+            y_label: "relaxation time tau",
+        };
+        let (figures, mut files) = operator_maps(
+            &ctx.out_dir,
+            "free_surface_map",
+            &p.operators,
+            &points,
+            |q| (q.operator, q.mach, q.tau, q.class, q.verdict),
+            &grid,
+            |op| format!("Dam break, {}: tau against the front's Mach number", op.name()),
+            |op| {
+                format!(
                     "{}: dam break (column {a} x {h} nodes, Martin & Moyce 1952) at each tau and front Mach \
                      number, run whatever the set-up check says. Colour: accurate (front within {} % of the \
                      experiment up to T = {}), inaccurate, blown up (stopped by the engine, or the interface \
@@ -216,10 +209,10 @@ impl Stage for FreeSurfaceMap {
                     p.t_end,
                     a = p.column,
                     h = 2 * p.column,
-                ),
-            });
-            files.push(file.into());
-        }
+                )
+            },
+        )?;
+        files.insert(0, csv.into());
         let disagree = points
             .iter()
             .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)

@@ -175,14 +175,22 @@ impl Stage for StabilityMap {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(p.threads).build()?;
         let points = pool.install(|| lbm::map(&p.operators, &p.taus, &p.machs, p.size, p.accuracy))?;
         write_points(&ctx.out_dir.join("stability_map.csv"), &points)?;
-        let mut figures = Vec::new();
-        let mut files: Vec<PathBuf> = vec!["stability_map.csv".into()];
-        for &op in &p.operators {
-            let file = format!("stability_map_{}.png", op.name().replace('/', "_"));
-            draw(&ctx.out_dir.join(&file), op, &points, p)?;
-            figures.push(Figure {
-                path: file.clone().into(),
-                caption: format!(
+        let grid = Grid {
+            xs: &p.machs,
+            ys: &p.taus,
+            x_label: "lattice Mach number u0/c_s",
+            y_label: "relaxation time tau",
+        };
+        let (figures, mut files) = operator_maps(
+            &ctx.out_dir,
+            "stability_map",
+            &p.operators,
+            &points,
+            |q| (q.operator, q.mach, q.tau, q.class, q.verdict),
+            &grid,
+            |op| format!("Taylor-Green, {}: tau against lattice Mach number", op.name()),
+            |op| {
+                format!(
                     "{}: Taylor-Green vortex ({} x {} nodes) at each tau and lattice Mach number, run whatever \
                      the set-up check says. Colour: accurate (nu error below {} %), inaccurate, blown up (stopped \
                      by the engine). Mark: none if the check accepts, a ring if it warns, a cross if it refuses.",
@@ -190,10 +198,10 @@ impl Stage for StabilityMap {
                     p.size,
                     p.size,
                     p.accuracy * 100.0
-                ),
-            });
-            files.push(file.into());
-        }
+                )
+            },
+        )?;
+        files.insert(0, "stability_map.csv".into());
         let disagree = points
             .iter()
             .filter(|q| q.verdict == Verdict::Accepted && q.class != Class::Accurate)
@@ -228,23 +236,55 @@ fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
     )
 }
 
-fn draw(path: &std::path::Path, op: Operator, points: &[Point], p: &Params) -> Result<()> {
-    let cells = points.iter().filter(|q| q.operator == op).map(|q| {
-        let ix = p.machs.iter().position(|&m| m == q.mach).unwrap_or(0);
-        let iy = p.taus.iter().position(|&t| t == q.tau).unwrap_or(0);
-        (ix, iy, q.class, q.verdict)
-    });
-    let x_ticks: Vec<String> = p.machs.iter().map(|m| format!("{m}")).collect();
-    let y_ticks: Vec<String> = p.taus.iter().map(|t| format!("{t}")).collect();
-    draw_map(
-        path,
-        cells,
-        &format!("Taylor-Green, {}: tau against lattice Mach number", op.name()),
-        "lattice Mach number u0/c_s",
-        "relaxation time tau",
-        &x_ticks,
-        &y_ticks,
-    )
+/// The axes of a per-operator map: the grid's values along x and y, and their labels.
+struct Grid<'a> {
+    xs: &'a [f64],
+    ys: &'a [f64],
+    x_label: &'a str,
+    y_label: &'a str,
+}
+
+/// One map per collision operator, `<stem>_<operator>.png` each: every point of that operator
+/// (`at` gives its operator, x, y, class and verdict) on `grid`, coloured by class and marked by
+/// verdict. The figures and their file names.
+#[allow(clippy::too_many_arguments)]
+fn operator_maps<P>(
+    out_dir: &std::path::Path,
+    stem: &str,
+    ops: &[Operator],
+    points: &[P],
+    at: impl Fn(&P) -> (Operator, f64, f64, Class, Verdict),
+    grid: &Grid,
+    title: impl Fn(Operator) -> String,
+    caption: impl Fn(Operator) -> String,
+) -> Result<(Vec<Figure>, Vec<PathBuf>)> {
+    let ticks = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<String>>();
+    let (x_ticks, y_ticks) = (ticks(grid.xs), ticks(grid.ys));
+    let index = |v: &[f64], x: f64| v.iter().position(|&w| w == x).unwrap_or(0);
+    let (mut figures, mut files) = (Vec::new(), Vec::new());
+    for &op in ops {
+        let file = format!("{stem}_{}.png", op.name().replace('/', "_"));
+        let cells = points
+            .iter()
+            .map(&at)
+            .filter(|c| c.0 == op)
+            .map(|(_, x, y, class, verdict)| (index(grid.xs, x), index(grid.ys, y), class, verdict));
+        draw_map(
+            &out_dir.join(&file),
+            cells,
+            &title(op),
+            grid.x_label,
+            grid.y_label,
+            &x_ticks,
+            &y_ticks,
+        )?;
+        figures.push(Figure {
+            path: file.clone().into(),
+            caption: caption(op),
+        });
+        files.push(file.into());
+    }
+    Ok((figures, files))
 }
 
 /// A map of (column, row, class, verdict) cells: colour by class, mark by verdict; the legend

@@ -88,22 +88,9 @@ fn energy(sys: &System, which: PackingLaw, k: f64) -> f64 {
     kinetic + elastic
 }
 
-/// Run `nx` × `ny` disks (ny even) under the linear law of stiffness `k` for `duration` critical
-/// steps at `ratio` × the critical step; `force` runs a step the stepper refuses. Errors are the
-/// stepper's set-up refusals.
-pub fn run(
-    k: f64,
-    nx: usize,
-    ny: usize,
-    ratio: f64,
-    duration: f64,
-    force: bool,
-    seed: u64,
-) -> Result<Drift, DemError> {
-    run_law(PackingLaw::Linear, k, nx, ny, ratio, duration, force, seed)
-}
-
-/// [`run`] under `which` law, with tangent stiffness `k` at the lattice's overlap.
+/// Run `nx` × `ny` disks (ny even) under `which` law, of tangent stiffness `k` at the lattice's
+/// overlap, for `duration` critical steps at `ratio` × the critical step; `force` runs a step the
+/// stepper refuses. Errors are the stepper's set-up refusals.
 #[allow(clippy::too_many_arguments)]
 pub fn run_law(
     which: PackingLaw,
@@ -189,8 +176,8 @@ mod tests {
 
     #[test]
     fn small_steps_conserve_the_energy_and_large_ones_do_not() {
-        let small = run(1e4, 8, 8, 0.05, 100.0, false, 1).unwrap();
-        let large = run(1e4, 8, 8, 2.0, 100.0, true, 1).unwrap();
+        let small = run_law(PackingLaw::Linear, 1e4, 8, 8, 0.05, 100.0, false, 1).unwrap();
+        let large = run_law(PackingLaw::Linear, 1e4, 8, 8, 2.0, 100.0, true, 1).unwrap();
         eprintln!(
             "packing: energy error {:.2e} at 0.05 dt_crit, {:.2e} at 2",
             small.energy_error, large.energy_error

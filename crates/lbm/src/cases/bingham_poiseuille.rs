@@ -6,7 +6,7 @@
 //! (tri-viscosity, Fig. 4) law the kernel applies, which separates the clamp's error from the
 //! lattice's. Run by `tests/bingham.rs` and by the `bingham-map` stability stage. No I/O.
 
-use crate::{Bingham, Collision, Domain, Face, Fluid, Lattice, LbmError, Limits, Macro, Settings, StepperAa};
+use crate::{Bingham, Collision, Fluid, Lattice, LbmError, Limits, Macro, Settings, StepperAa};
 
 /// One Bingham channel case: `h_nodes` fluid rows between halfway bounce-back walls (half-width
 /// h = h_nodes/2), plastic viscosity from τ_pl, plug half-width `y0_frac` h, plug velocity `u_p`.
@@ -115,22 +115,6 @@ pub struct Outcome {
     pub stopped: Option<LbmError>,
 }
 
-/// Walls on y, periodic x and z: the 3D channel.
-fn walls_3d(n: [usize; 3]) -> Domain {
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    Domain::new(
-        n,
-        [
-            Face::Periodic,
-            Face::Periodic,
-            wall,
-            wall,
-            Face::Periodic,
-            Face::Periodic,
-        ],
-    )
-}
-
 /// Run the channel on the AA stepper (the default kernel) from rest to a steady state (the
 /// largest change of u over 1000 steps below 1e-11 u_p) or `max_steps`. Errors are set-up
 /// refusals; a node leaving the limits ends the run with `stopped`.
@@ -141,11 +125,7 @@ pub fn run_channel<L: Lattice>(
     nz: usize,
     max_steps: usize,
 ) -> Result<Outcome, LbmError> {
-    let dom = if L::D == 2 {
-        super::poiseuille::channel(nx, case.h_nodes)
-    } else {
-        walls_3d([nx, case.h_nodes, nz])
-    };
+    let dom = super::poiseuille::channel_box([nx, case.h_nodes, if L::D == 2 { 1 } else { nz }]);
     let mut fl = Fluid::<L, f64>::new(dom, Vec::new());
     let settings = Settings {
         collision,

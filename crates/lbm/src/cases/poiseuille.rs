@@ -19,9 +19,15 @@ pub struct ChannelRun {
 /// `nx` columns periodic in x, `h` fluid rows between resting walls at y = −½ and h − ½
 /// (halfway bounce-back).
 pub fn channel(nx: usize, h: usize) -> Domain {
+    channel_box([nx, h, 1])
+}
+
+/// The channel in a box of `n` nodes: resting walls on y, periodic in x and z (D3Q19 with
+/// n[2] > 1).
+pub fn channel_box(n: [usize; 3]) -> Domain {
     let wall = Face::Wall { velocity: [0.0; 3] };
     Domain::new(
-        [nx, h, 1],
+        n,
         [
             Face::Periodic,
             Face::Periodic,

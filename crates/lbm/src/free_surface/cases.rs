@@ -85,18 +85,8 @@ pub fn layer(
     g: f64,
     collision: Collision,
 ) -> Result<(FreeSurface<D2Q9>, FreeSurfaceStepper<D2Q9>), LbmError> {
-    let wall = Face::Wall { velocity: [0.0; 3] };
-    let dom = Domain::new(
-        [nx, ny, 1],
-        [
-            Face::Periodic,
-            Face::Periodic,
-            wall,
-            wall,
-            Face::Periodic,
-            Face::Periodic,
-        ],
-    );
+    // walls below and above, periodic in x: the channel's box
+    let dom = crate::cases::poiseuille::channel_box([nx, ny, 1]);
     let params = FreeSurfaceParams::default();
     let k = 2.0 * std::f64::consts::PI / nx as f64;
     // heights from the halfway bottom wall: node y spans [y, y + 1], its centre is at y + ½
