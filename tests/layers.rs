@@ -105,7 +105,7 @@ fn layer_check_sees_a_bad_import() {
 fn engine_kernels_import_nothing_from_their_steppers() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates");
     let kernels = [
-        "dem/src/pair_linear.rs",
+        "dem/src/pair_batched.rs",
         "dem/src/kick_disks.rs",
         "dem/src/scratch.rs",
         "lbm/src/kernel.rs",

@@ -20,7 +20,7 @@ pub mod neighbor;
 mod on_arrays;
 #[cfg(target_arch = "x86_64")]
 mod on_avx512;
-mod pair_linear;
+mod pair_batched;
 pub mod polygon;
 mod scratch;
 pub mod shape;

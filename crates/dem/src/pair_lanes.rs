@@ -1,32 +1,34 @@
-//! The lane code of the linear pair kernel (`crate::pair_linear`), written once against a lane
-//! type `super::lanes` and compiled for each (`crate::on_avx512`, `crate::on_arrays`).
+//! The lane code of the batched pair kernel (`crate::pair_batched`), written once against a
+//! lane type `super::lanes` and compiled for each (`crate::on_avx512`, `crate::on_arrays`).
 
 use super::lanes::{self, F8, M8};
-use crate::contact::History;
+use crate::contact::{BatchedNormal, History};
 use crate::lanes::W;
-use crate::pair_linear::LinearPair;
+use crate::pair_batched::BatchedPair;
 use crate::scratch::{CircleState, PairOut};
 
-/// Every pair of `pairs`, the damping form chosen once per call.
+/// Every pair of `pairs`, the damping form and the normal law chosen once per call.
 #[inline(always)]
 pub(crate) fn run(
-    kp: &LinearPair,
+    kp: &BatchedPair,
     cst: &[CircleState],
     pairs: &[[u32; 2]],
     hist: &mut [History],
     out: &mut [PairOut],
     touch: &mut [u8],
 ) {
-    if kp.gamma {
-        run_damp::<true>(kp, cst, pairs, hist, out, touch);
-    } else {
-        run_damp::<false>(kp, cst, pairs, hist, out, touch);
+    let plastic = matches!(kp.normal, BatchedNormal::Plastic { .. });
+    match (kp.gamma, plastic) {
+        (true, false) => run_law::<true, false>(kp, cst, pairs, hist, out, touch),
+        (false, false) => run_law::<false, false>(kp, cst, pairs, hist, out, touch),
+        (true, true) => run_law::<true, true>(kp, cst, pairs, hist, out, touch),
+        (false, true) => run_law::<false, true>(kp, cst, pairs, hist, out, touch),
     }
 }
 
 #[inline(always)]
-fn run_damp<const GAMMA: bool>(
-    kp: &LinearPair,
+fn run_law<const GAMMA: bool, const PLASTIC: bool>(
+    kp: &BatchedPair,
     cst: &[CircleState],
     pairs: &[[u32; 2]],
     hist: &mut [History],
@@ -49,33 +51,33 @@ fn run_damp<const GAMMA: bool>(
         let cj = Lanes::gather(cst, &jx);
         if m == W {
             let h: &mut [History; W] = (&mut hist[q..q + W]).try_into().expect("eight histories");
-            let (hx, hy, keep) = lanes::hist_load(h);
-            let r = eight::<GAMMA>(kp, &ci, &cj, hx, hy);
-            hist_store(h, r.xix, r.xiy, keep, r.touch);
+            let (hx, hy, other) = lanes::hist_load(h);
+            let r = eight::<GAMMA, PLASTIC>(kp, &ci, &cj, [hx, hy, other[0], other[1]]);
+            hist_store(h, r.hist);
             let o: &mut [PairOut; W] = (&mut out[q..q + W]).try_into().expect("eight records");
             store4(o, [r.fx, r.fy, r.ti, r.tj]);
             for k in 0..W {
                 touch[q + k] = u8::from(r.touch.bit(k));
             }
         } else {
-            let hx = F8::from_array(std::array::from_fn(|k| hist[lane(k)].xi_t.x));
-            let hy = F8::from_array(std::array::from_fn(|k| hist[lane(k)].xi_t.y));
-            let r = eight::<GAMMA>(kp, &ci, &cj, hx, hy);
-            let (xix, xiy, fx, fy) = (
-                r.xix.to_array(),
-                r.xiy.to_array(),
-                r.fx.to_array(),
-                r.fy.to_array(),
-            );
+            let field = |f: fn(&History) -> f64| F8::from_array(std::array::from_fn(|k| f(&hist[lane(k)])));
+            let h0 = [
+                field(|h| h.xi_t.x),
+                field(|h| h.xi_t.y),
+                field(|h| h.theta_r),
+                field(|h| h.delta_p),
+            ];
+            let r = eight::<GAMMA, PLASTIC>(kp, &ci, &cj, h0);
+            let [xix, xiy, th, dp] = r.hist.map(F8::to_array);
+            let (fx, fy) = (r.fx.to_array(), r.fy.to_array());
             let (ti, tj) = (r.ti.to_array(), r.tj.to_array());
             for k in 0..m {
-                let h = &mut hist[q + k];
-                let t = r.touch.bit(k);
-                h.xi_t.x = xix[k];
-                h.xi_t.y = xiy[k];
-                h.theta_r = if t { h.theta_r } else { 0.0 };
-                h.delta_p = if t { h.delta_p } else { 0.0 };
-                touch[q + k] = u8::from(t);
+                hist[q + k] = History {
+                    xi_t: crate::Vec2::new(xix[k], xiy[k]),
+                    theta_r: th[k],
+                    delta_p: dp[k],
+                };
+                touch[q + k] = u8::from(r.touch.bit(k));
                 out[q + k] = PairOut {
                     fx: fx[k],
                     fy: fy[k],
@@ -88,10 +90,16 @@ fn run_damp<const GAMMA: bool>(
     }
 }
 
-/// Eight pairs. Untouched lanes: zeros.
+/// Eight pairs, their histories `h` as lanes (ξ_x, ξ_y, θ_r, δ_p). Untouched lanes: zeros.
 #[inline(always)]
-fn eight<const GAMMA: bool>(kp: &LinearPair, ci: &Lanes, cj: &Lanes, hx: F8, hy: F8) -> LaneOut {
+fn eight<const GAMMA: bool, const PLASTIC: bool>(
+    kp: &BatchedPair,
+    ci: &Lanes,
+    cj: &Lanes,
+    h: [F8; 4],
+) -> LaneOut {
     let zero = F8::splat(0.0);
+    let [hx, hy, theta, dp] = h;
     let dx = min_image(cj.x - ci.x, kp.half[0], kp.l[0]);
     let dy = min_image(cj.y - ci.y, kp.half[1], kp.l[1]);
     let (ri, rj) = (ci.r, cj.r);
@@ -113,16 +121,30 @@ fn eight<const GAMMA: bool>(kp: &LinearPair, ci: &Lanes, cj: &Lanes, hx: F8, hy:
     let (vx, vy) = (vix - vjx, viy - vjy);
     let (mi, mj) = (ci.m, cj.m);
     let m_eff = mi * mj / (mi + mj);
+    let k_n = F8::splat(kp.k_damp());
     let cn = if GAMMA {
         F8::splat(kp.damp) * m_eff
     } else {
-        F8::splat(2.0 * kp.damp) * (F8::splat(kp.k_n) * m_eff).sqrt()
+        F8::splat(2.0 * kp.damp) * (k_n * m_eff).sqrt()
     };
     let vn = vx * nx + vy * ny;
-    let mut f_n = F8::splat(kp.k_n) * delta + cn * vn;
-    if kp.clip {
-        f_n = f_n.lt(zero).select(zero, f_n);
-    }
+    let (f_n, dp) = match kp.normal {
+        // Su et al. 2020 Eq. 6 (contact::ElasticPlastic::normal): elastic to the yield
+        // envelope F_y + k_p (δ − F_y/k_e), plastic along it, the dashpot only while loaded.
+        BatchedNormal::Plastic { k_e, k_p, f_y } if PLASTIC => {
+            let f = k_n * (delta - dp);
+            let env = F8::splat(f_y) + F8::splat(k_p) * (delta - F8::splat(f_y / k_e));
+            let yields = f.gt(env);
+            let dp = yields.select(delta - env / k_n, dp);
+            let f_el = yields.select(env, f).max0();
+            (f_el.gt(zero).select((f_el + cn * vn).max0(), zero), dp)
+        }
+        BatchedNormal::Linear { clip, .. } if !PLASTIC => {
+            let f_n = k_n * delta + cn * vn;
+            (if clip { f_n.lt(zero).select(zero, f_n) } else { f_n }, dp)
+        }
+        _ => unreachable!("run picks PLASTIC from the law"),
+    };
     // Tangential spring (contact::tangential).
     let (kt, ct) = (F8::splat(kp.k_t), cn * F8::splat(kp.t_frac));
     let dt = F8::splat(kp.dt);
@@ -145,15 +167,26 @@ fn eight<const GAMMA: bool>(kp: &LinearPair, ci: &Lanes, cj: &Lanes, hx: F8, hy:
     let ey = kpos.select(-(sy + vty * ct) * ikt, zero);
     let (ftx, fty) = (slide.select(sx, ftx), slide.select(sy, fty));
     let (xix, xiy) = (slide.select(ex, xix), slide.select(ey, xiy));
+    // Rolling spring with its limit μ_r r* F_n (contact::Rolling::torque).
+    let (m_roll, theta) = match kp.rolling {
+        Some([k_r, mu_r]) => {
+            let th = theta + (wi - wj) * dt;
+            let m = F8::splat(-k_r) * th;
+            let lim = F8::splat(mu_r) * (ri * rj / rs) * f_n.max0();
+            let over = m.abs().gt(lim);
+            let m = over.select(lim.copysign(m), m);
+            (m, over.select(-m / F8::splat(k_r), th))
+        }
+        None => (zero, theta),
+    };
     let fx = ftx - nx * f_n;
     let fy = fty - ny * f_n;
     let nxf = nx * fy - ny * fx;
-    let ti = ai * nxf + zero;
-    let tj = aj * nxf - zero;
+    let ti = ai * nxf + m_roll;
+    let tj = aj * nxf - m_roll;
     LaneOut {
         touch: touching,
-        xix: touching.select(xix, zero),
-        xiy: touching.select(xiy, zero),
+        hist: [xix, xiy, theta, dp].map(|v| touching.select(v, zero)),
         fx: touching.select(fx, zero),
         fy: touching.select(fy, zero),
         ti: touching.select(ti, zero),
@@ -172,8 +205,8 @@ fn min_image(d: F8, half: f64, l: f64) -> F8 {
 
 struct LaneOut {
     touch: M8,
-    xix: F8,
-    xiy: F8,
+    /// The new history (ξ_x, ξ_y, θ_r, δ_p), zero where untouched.
+    hist: [F8; 4],
     fx: F8,
     fy: F8,
     ti: F8,
@@ -209,16 +242,11 @@ impl Lanes {
     }
 }
 
-/// Store eight histories: new elongations; the other fields kept where touching, else zero.
+/// Store eight histories (lanes ξ_x, ξ_y, θ_r, δ_p, already zero where untouched).
 #[inline(always)]
-fn hist_store(h: &mut [History; W], xix: F8, xiy: F8, other: [F8; 2], touch: M8) {
-    let zero = F8::splat(0.0);
-    let (t, p) = (touch.select(other[0], zero), touch.select(other[1], zero));
+fn hist_store(h: &mut [History; W], v: [F8; 4]) {
     // SAFETY: History is repr(C): four f64, 32 bytes.
-    lanes::store4(
-        unsafe { &mut *h.as_mut_ptr().cast::<[[f64; 4]; W]>() },
-        [xix, xiy, t, p],
-    );
+    lanes::store4(unsafe { &mut *h.as_mut_ptr().cast::<[[f64; 4]; W]>() }, v);
 }
 
 /// Store eight pair results (lanes to records).

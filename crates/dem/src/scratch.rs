@@ -1,5 +1,5 @@
 //! Packed scratch records shared by the stepper's passes and the batched kernels
-//! (`pair_linear.rs`, `kick_disks.rs`): they import these from here, never from the stepper.
+//! (`pair_batched.rs`, `kick_disks.rs`): they import these from here, never from the stepper.
 
 use crate::vector::Vec2;
 

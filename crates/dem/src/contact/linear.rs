@@ -3,7 +3,10 @@
 //! rolling resistance parts" of Su et al. 2020 Sect. 2.3; Ness et al. 2017 Eq. 6 frictional
 //! contacts: F_n = k_n δ n, |F_t| ≤ μ |F_n|).
 
-use super::{ContactInput, ContactLaw, ContactOutput, Damping, History, Rolling, SpringDashpots, tangential};
+use super::{
+    Batched, BatchedNormal, ContactInput, ContactLaw, ContactOutput, Damping, History, Rolling,
+    SpringDashpots, tangential,
+};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -82,7 +85,17 @@ impl ContactLaw for LinearSpringDashpot {
         let cn = self.damping.coefficient(self.k_n, m_eff);
         SpringDashpots::frictional((self.k_n, cn), (self.k_t, cn * self.tangential_damping), self.mu)
     }
-    fn linear(&self) -> Option<&LinearSpringDashpot> {
-        Some(self)
+    fn batched(&self) -> Option<Batched> {
+        (self.mu > 0.0).then_some(Batched {
+            normal: BatchedNormal::Linear {
+                k_n: self.k_n,
+                clip: self.clip,
+            },
+            damping: self.damping,
+            k_t: self.k_t,
+            t_frac: self.tangential_damping,
+            mu: self.mu,
+            rolling: self.rolling,
+        })
     }
 }

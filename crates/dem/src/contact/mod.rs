@@ -19,7 +19,7 @@ pub use hertz::HertzMindlin;
 pub use linear::LinearSpringDashpot;
 pub use plastic::ElasticPlastic;
 
-/// The history of the linear, Hertz and elastic-plastic laws (`repr(C)`: the batched linear pair
+/// The history of the linear, Hertz and elastic-plastic laws (`repr(C)`: the batched pair
 /// kernel loads four of them as two 512-bit lines).
 #[derive(
     Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable,
@@ -100,12 +100,36 @@ pub trait ContactLaw: Sync + Send {
     fn wall_range(&self, _r: f64) -> f64 {
         0.0
     }
-    /// The law as the linear spring-dashpot, if it is one: the stepper then uses its batched
-    /// pair kernel (same bits as [`ContactLaw::force`]). Return `Some` only if `Self::History`
-    /// is laid out as [`History`] (the kernel reads and writes the records as `History`).
-    fn linear(&self) -> Option<&LinearSpringDashpot> {
+    /// The law in the terms of the stepper's batched pair kernel, if it has them: the stepper
+    /// then evaluates eight pairs per instruction (same bits as [`ContactLaw::force`]). Return
+    /// `Some` only if `Self::History` is laid out as [`History`] (the kernel reads and writes
+    /// the records as `History`) and `force` is, operation for operation, the [`Batched`] form.
+    fn batched(&self) -> Option<Batched> {
         None
     }
+}
+
+/// The normal force of a law the batched pair kernel evaluates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BatchedNormal {
+    /// k_n δ + c_n v_n, clipped at zero if `clip` ([`LinearSpringDashpot`]).
+    Linear { k_n: f64, clip: bool },
+    /// Su et al. 2020 Eq. 6's elastic-plastic envelope with its plastic overlap in
+    /// [`History::delta_p`] ([`ElasticPlastic::normal`]), then the dashpot, clipped at zero.
+    Plastic { k_e: f64, k_p: f64, f_y: f64 },
+}
+
+/// A law as the batched pair kernel sees it: a normal force ([`BatchedNormal`]) with the dashpot
+/// `damping` of its normal stiffness, the tangential spring of [`tangential`] (dashpot
+/// `t_frac` × c_n, Coulomb `mu` > 0) and an optional [`Rolling`] spring.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Batched {
+    pub normal: BatchedNormal,
+    pub damping: Damping,
+    pub k_t: f64,
+    pub t_frac: f64,
+    pub mu: f64,
+    pub rolling: Option<Rolling>,
 }
 
 /// A contact's springs and dashpots, as (k N/m, c N s/m), along the normal and the tangent.
@@ -273,9 +297,9 @@ macro_rules! register_laws {
                     $(Law::$variant(l) => l.wall_range(r),)+
                 }
             }
-            fn linear(&self) -> Option<&LinearSpringDashpot> {
+            fn batched(&self) -> Option<Batched> {
                 match self {
-                    $(Law::$variant(l) => l.linear(),)+
+                    $(Law::$variant(l) => l.batched(),)+
                 }
             }
         }

@@ -4,7 +4,9 @@
 //! dependent through Eq. 6: F_y − F_0 ≈ 2.40e-8 (du_y/dt)^0.26 (SI: N, m/s), see [`su_yield_force`].
 //! Tangential spring with Coulomb limit, damping and rolling resistance as in the linear law.
 
-use super::{ContactInput, ContactLaw, ContactOutput, Damping, History, Rolling, tangential};
+use super::{
+    Batched, BatchedNormal, ContactInput, ContactLaw, ContactOutput, Damping, History, Rolling, tangential,
+};
 use crate::vector::Vec2;
 use serde::{Deserialize, Serialize};
 
@@ -116,5 +118,19 @@ impl ContactLaw for ElasticPlastic {
     }
     fn friction(&self) -> f64 {
         self.mu
+    }
+    fn batched(&self) -> Option<Batched> {
+        (self.mu > 0.0).then_some(Batched {
+            normal: BatchedNormal::Plastic {
+                k_e: self.k_e,
+                k_p: self.k_p,
+                f_y: self.f_y,
+            },
+            damping: self.damping,
+            k_t: self.k_t,
+            t_frac: TANGENTIAL_DAMPING,
+            mu: self.mu,
+            rolling: self.rolling,
+        })
     }
 }

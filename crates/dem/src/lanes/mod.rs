@@ -1,6 +1,6 @@
-//! Eight f64 lanes for the batched kernels (pairs of the linear law, the all-disk kick). Every
-//! operation is the scalar IEEE operation per lane (no fused multiply-add, same rounding), so a
-//! lane's bits equal the scalar code's, whichever lane type runs.
+//! Eight f64 lanes for the batched kernels (pairs of the linear and elastic-plastic laws, the
+//! all-disk kick). Every operation is the scalar IEEE operation per lane (no fused multiply-add,
+//! same rounding), so a lane's bits equal the scalar code's, whichever lane type runs.
 //!
 //! Two lane types with the same interface: [`avx512`] (one register per value, one mask
 //! register per mask) and [`portable`] (arrays the compiler vectorises). The kernels that use

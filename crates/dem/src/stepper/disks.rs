@@ -6,7 +6,7 @@
 //! follow in a second pass.
 
 use super::finish::{Bodies5, Finish};
-use super::pairs::{Generic, PairKernel, circle_sum, linear_kernel};
+use super::pairs::{Generic, PairKernel, circle_sum};
 use super::{CIRCLE_CHUNK, Stepper};
 use crate::contact::{ContactLaw, History};
 use crate::scratch::{CircleState, Kick, PairOut};
@@ -19,7 +19,7 @@ impl Stepper {
     pub(super) fn forces_disks<L: ContactLaw>(&mut self, dt: f64, law: &L, sys: &mut System, fin: &Finish) {
         let dom = sys.domain;
         let n = sys.contacts.pairs.len();
-        match linear_kernel(law, &dom, dt) {
+        match crate::pair_batched::BatchedPair::of(law, &dom, dt) {
             Some(k) => {
                 let hist = sys.contacts.hist.conform::<History>(n);
                 fused(self, fin, &sys.contacts.pairs, hist, &mut sys.bodies, &k);

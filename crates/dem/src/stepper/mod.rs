@@ -277,7 +277,7 @@ impl Stepper {
 
     /// [`Stepper::step`] compiled in this crate for the scene-selectable [`Law`]: the pair law
     /// is dispatched once per step to the pass monomorphised for it (batched kernel for the
-    /// linear law), the wall law through the enum.
+    /// linear and elastic-plastic laws), the wall law through the enum.
     #[inline(never)]
     pub fn step_law(
         &mut self,

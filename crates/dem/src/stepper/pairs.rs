@@ -1,28 +1,19 @@
 //! The pair pass: the pair law over every pair of the Verlet list (in parallel over fixed chunks
 //! of pairs), one record per pair; then the per-body gather of those records in canonical order.
-//! The generic loop serves any [`ContactLaw`] (monomorphised, the law inlined); the linear law
-//! takes the batched kernel of `pair_linear.rs` (same bits).
+//! The generic loop serves any [`ContactLaw`] (monomorphised, the law inlined); the laws with a
+//! [`ContactLaw::batched`] form (linear, elastic-plastic) take the batched kernel of
+//! `pair_batched.rs` (same bits).
 
 use super::finish::{Bodies5, Finish};
 use super::{PAIR_CHUNK, Stepper};
 use crate::contact::{ContactInput, ContactLaw, History};
 use crate::domain::Domain;
-use crate::history::stride_of;
-use crate::pair_linear::LinearPair;
+use crate::pair_batched::BatchedPair;
 use crate::scratch::{CircleState, Kick, PairOut};
 use crate::system::System;
 use crate::vector::{Vec2, Vector};
 use lbdem_core::simd::{self, Simd, WithSimd};
 use rayon::prelude::*;
-
-/// The batched linear kernel for `law`, if it applies (see [`ContactLaw::linear`]).
-#[inline]
-pub(super) fn linear_kernel<L: ContactLaw>(law: &L, dom: &Domain, dt: f64) -> Option<LinearPair> {
-    if stride_of::<L::History>() != stride_of::<History>() {
-        return None;
-    }
-    law.linear().and_then(|l| LinearPair::new(l, dom, dt))
-}
 
 /// A pair kernel: every pair of a slice, compiled into an op of `lbdem_core::simd::dispatch`
 /// at level `S` (so it must inline: `#[inline(always)]`).
@@ -38,7 +29,7 @@ pub(super) trait PairKernel: Sync {
     );
 }
 
-impl PairKernel for LinearPair {
+impl PairKernel for BatchedPair {
     type H = History;
     #[inline(always)]
     fn run<S: Simd>(
@@ -100,7 +91,7 @@ impl Stepper {
         let dom = sys.domain;
         let pairs = &sys.contacts.pairs;
         let n = pairs.len();
-        match linear_kernel(law, &dom, dt) {
+        match BatchedPair::of(law, &dom, dt) {
             Some(k) => {
                 let hist = sys.contacts.hist.conform::<History>(n);
                 self.chunked(pairs, hist, &k);
