@@ -52,6 +52,10 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::stability_map::dem::DemStepMap>(&["dem-step-map"], CliShape::ParamsFile),
     entry::<stages::stability_map::bingham::BinghamMap>(&["bingham-map"], CliShape::ParamsFile),
     entry::<stages::stability_map::free_surface::FreeSurfaceMap>(&["free-surface-map"], CliShape::ParamsFile),
+    entry::<stages::stability_map::interior_liquid::InteriorLiquidMap>(
+        &["interior-liquid-map"],
+        CliShape::ParamsFile,
+    ),
     entry::<stages::report::Report>(&["report"], CliShape::ParamsFile),
     entry::<stages::analyse::Analyse>(&["analyse"], CliShape::ParamsFile),
     entry::<stages::synth_run::SynthRun>(&["synth", "run"], CliShape::ParamsFile),

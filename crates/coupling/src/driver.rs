@@ -15,6 +15,11 @@ use lbdem_dem::{Law, StepParams, Stepper, System, Vec2};
 use lbdem_lbm::Real;
 use std::time::{Duration, Instant};
 
+/// The lightest wet grain, over the liquid's density, for which
+/// [`Coupled::with_interior_liquid_correction`] is accepted: Uhlmann (2005) reports the explicit
+/// correction stable down to about 1.2.
+pub const INTERIOR_LIQUID_MIN_RATIO: f64 = 1.2;
+
 /// Wall-clock time spent in each part of the loop.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Timing {
@@ -226,28 +231,38 @@ impl<T: Real> Coupled<T> {
     /// motion to its present one takes (Uhlmann, J. Comput. Phys. 209 (2005) 448, Eq. 15, the
     /// rigid-body approximation of the interior liquid), with the weights of
     /// [`Hydro::interior_liquid`]. It is explicit; Uhlmann reports it stable for density ratios
-    /// down to about 1.2 (`tests/added_mass.rs` checks 1.25, not below), so the lightest grain
-    /// that feels the liquid must be at least 1.2 times denser than it.
+    /// down to about 1.2 (`tests/added_mass.rs` checks 1.25), so the lightest grain that feels
+    /// the liquid must be at least [`INTERIOR_LIQUID_MIN_RATIO`] times denser than it. Conservative
+    /// on every case run: `lbdem interior-liquid-map` (a settling disk) found its edge at 0.3-0.7,
+    /// lower the better the grain is resolved (docs/stability.md, "Near-neutral grains").
     ///
     /// With it on, [`Coupled::momentum`] (all the liquid plus the grains) is no longer conserved:
     /// the liquid inside the grains is counted twice.
-    pub fn with_interior_liquid_correction(mut self) -> Result<Self, CouplingError> {
+    pub fn with_interior_liquid_correction(self) -> Result<Self, CouplingError> {
+        let rho_f = self.units.lattice.rho;
+        let lightest = self.lightest_wet_density();
+        let ratio = lightest / rho_f;
+        if ratio.is_nan() || ratio < INTERIOR_LIQUID_MIN_RATIO {
+            return Err(CouplingError::Unsupported(format!(
+                "interior-liquid correction with grain/liquid density ratio {ratio:.3} (lightest wet grain \
+                 {lightest} kg/m³, liquid {rho_f} kg/m³): it is explicit and unstable below about \
+                 {INTERIOR_LIQUID_MIN_RATIO} (Uhlmann 2005; docs/stability.md, \"Near-neutral grains\"); \
+                 switch it off for near-neutral grains"
+            )));
+        }
+        self.force_interior_liquid_correction()
+    }
+
+    /// [`Coupled::with_interior_liquid_correction`] without its density-ratio refusal: for the
+    /// stability map that finds where the refusal should sit (`lbdem interior-liquid-map`), not
+    /// for scenes. Still PSM only.
+    pub fn force_interior_liquid_correction(mut self) -> Result<Self, CouplingError> {
         if self.fluid.method() != crate::hydro::Method::Psm {
             return Err(CouplingError::Unsupported(
                 "the interior-liquid correction is for PSM; bounce-back grains hold no liquid: \
                  switch it off or use method = \"psm\""
                     .into(),
             ));
-        }
-        let rho_f = self.units.lattice.rho;
-        let lightest = self.lightest_wet_density();
-        let ratio = lightest / rho_f;
-        if ratio.is_nan() || ratio < 1.2 {
-            return Err(CouplingError::Unsupported(format!(
-                "interior-liquid correction with grain/liquid density ratio {ratio:.3} (lightest wet grain \
-                 {lightest} kg/m³, liquid {rho_f} kg/m³): it is explicit and unstable below about 1.2 \
-                 (Uhlmann 2005); switch it off for near-neutral grains"
-            )));
         }
         self.interior_liquid_correction = true;
         Ok(self)

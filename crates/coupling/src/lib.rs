@@ -32,7 +32,7 @@ pub use lbdem_core::units::coupled as units;
 
 pub use bounce::{BounceFluid, BounceState};
 pub use confine::{Confinement, MembraneBoundary};
-pub use driver::{Coupled, CoupledState};
+pub use driver::{Coupled, CoupledState, INTERIOR_LIQUID_MIN_RATIO};
 pub use error::CouplingError;
 pub use hydro::{Hydro, HydroState, Method};
 pub use psm::{GrainMotion, LIQUID, Load, PsmFluid, PsmSettings, PsmState, ZoneExchange, ZoneMass};

@@ -15,7 +15,9 @@ use crate::scenes::schema::Scene;
 use crate::scenes::snapshot::{FluidFields, write_fluid, write_particles};
 use crate::scenes::timeloop::{Model, Probe};
 use anyhow::{Context, Result, bail};
-use lbdem_core::units::coupled::{LOAD_DENSITY_MAX, PSM_DENSITY_RATIO_MIN, buoyant_load};
+use lbdem_core::units::coupled::{
+    LOAD_DENSITY_MAX, PSM_DENSITY_RATIO_MIN, PSM_DENSITY_RATIO_WARN, buoyant_load,
+};
 use lbdem_coupling::MembraneBoundary;
 use lbdem_coupling::bounce::BounceFluid;
 use lbdem_coupling::units::CouplingUnits;
@@ -561,8 +563,8 @@ fn damped_membrane(s: &Scene) -> Result<()> {
 
 /// Refuse a PSM scene whose lightest wet grain is under [`PSM_DENSITY_RATIO_MIN`] times the
 /// liquid's density (its inertia, mass scaling included): the explicit coupling blows up there
-/// (docs/stability.md, "Near-neutral grains"). Warn below 0.68, the lightest ratio the map found
-/// accurate.
+/// (docs/stability.md, "Near-neutral grains"). Warn below [`PSM_DENSITY_RATIO_WARN`], above the
+/// highest ratio at which the settling disk of the interior-liquid map blew up.
 fn light_grains<T: Real>(run: &Coupled<T>, s: &Scene) -> Result<()> {
     let lightest = run.lightest_wet_density();
     let ratio = lightest / run.liquid_density();
@@ -580,10 +582,13 @@ fn light_grains<T: Real>(run: &Coupled<T>, s: &Scene) -> Result<()> {
             run.liquid_density()
         );
     }
-    if ratio < 0.68 && !crate::contract::quiet() {
+    if ratio < PSM_DENSITY_RATIO_WARN && !crate::contract::quiet() {
         eprintln!(
             "coupled: warning: the lightest wet grain is {ratio:.3} times the liquid's density; the reduced \
-             shear cell ran but drifted at 0.56 and was accurate from 0.68 (docs/stability.md)"
+             shear cell ran from 0.56 (accurate from 0.68), but a disk settling in open liquid blew up up to \
+             0.8 and ran from 0.9 (docs/stability.md, \"Near-neutral grains\"): raise [dem] mass_scale to \
+             {:.3} or more if the run is quasi-static",
+            scale * PSM_DENSITY_RATIO_WARN / ratio
         );
     }
     Ok(())

@@ -8,6 +8,7 @@
 pub mod bingham;
 pub mod dem;
 pub mod free_surface;
+pub mod interior_liquid;
 pub mod lbm;
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};

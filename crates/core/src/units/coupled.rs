@@ -90,6 +90,13 @@ pub const LOAD_DENSITY_MAX: f64 = 0.5;
 /// 0.45 and below blew up, every run at 0.56 and above finished. Su's cases sit at 0.90-0.97.
 pub const PSM_DENSITY_RATIO_MIN: f64 = 0.5;
 
+/// Grain-to-liquid density ratio under which a PSM scene is warned (above
+/// [`PSM_DENSITY_RATIO_MIN`] it still runs): where the edge sits depends on the case. A disk
+/// settling in open liquid (`lbdem interior-liquid-map`, docs/stability.md "Near-neutral grains")
+/// blew up at 0.7 with 4 and 6 cells per diameter and at 0.8 with 10 (τ 0.8 and 1), and ran at
+/// 0.9 at every resolution; the shear cell above ran from 0.56.
+pub const PSM_DENSITY_RATIO_WARN: f64 = 0.85;
+
 /// The pressure difference (Pa) the liquid must carry when the grains move through it as one
 /// packing: their buoyant weight over the box's width, Δp = Σ m_i |a| / (W d), with `mass` the
 /// grains' total mass (kg, over the sample depth `depth`, m), `accel` the net acceleration the DEM

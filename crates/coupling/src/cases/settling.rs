@@ -48,6 +48,10 @@ pub struct SettlingSpec {
     pub method: Method,
     /// Simulated time in units of the viscous time W²/ν.
     pub duration: f64,
+    /// The interior-liquid correction ([`Coupled::with_interior_liquid_correction`]), PSM only.
+    pub interior_liquid_correction: bool,
+    /// Switch it on even below the density ratio the run-time check refuses (stability maps).
+    pub force_past_refusal: bool,
 }
 
 impl Default for SettlingSpec {
@@ -64,6 +68,8 @@ impl Default for SettlingSpec {
             tau: 1.0,
             method: Method::Psm,
             duration: 0.6,
+            interior_liquid_correction: false,
+            force_past_refusal: false,
         }
     }
 }
@@ -102,7 +108,7 @@ pub fn run<T: Real>(spec: &SettlingSpec) -> Result<SettlingResult, CouplingError
     let dx = d / spec.cells_per_diameter as f64;
     let (w, h) = (spec.width * d, spec.height * d);
     let u_ref = spec.reference_velocity();
-    let b = super::closed_box([w, h], dx, spec.nu, spec.rho_f, 2.0 * u_ref, spec.tau, 1)?;
+    let b = super::closed_box([w, h], dx, spec.nu, spec.rho_f, 2.0 * u_ref.abs(), spec.tau, 1)?;
     let (dt, units, domain) = (b.dt, b.units, b.domain);
     let limits = Limits::default();
     let hydro = match spec.method {
@@ -135,6 +141,13 @@ pub fn run<T: Real>(spec: &SettlingSpec) -> Result<SettlingResult, CouplingError
     params.gravity = Vec2::new(0.0, -spec.g);
     params.gravity_factor = 1.0 - spec.rho_f / spec.rho_p;
     let mut run = Coupled::new(hydro, sys, law.clone(), law, params, units, 1.0)?;
+    if spec.interior_liquid_correction {
+        run = if spec.force_past_refusal {
+            run.force_interior_liquid_correction()?
+        } else {
+            run.with_interior_liquid_correction()?
+        };
+    }
 
     let steps = (spec.duration * w * w / spec.nu / dt).ceil() as u64;
     let window = (steps / 6).max(1);
