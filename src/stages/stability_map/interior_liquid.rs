@@ -9,8 +9,8 @@
 //! inaccurate, or blown up (stopped by the engine's limits). What the run-time checks of a coupled
 //! scene say of the same grain ([`verdict`]) is recorded beside each point.
 
-use super::{Class, Verdict, draw_map};
-use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, MapKey, Verdict, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput, Table};
 use crate::report::table::{Col, write_table};
 use anyhow::{Result, anyhow, bail};
 use lbdem_core::units::coupled::{PSM_DENSITY_RATIO_MIN, PSM_DENSITY_RATIO_WARN};
@@ -70,7 +70,7 @@ pub enum Correction {
     On,
 }
 
-impl Correction {
+impl super::MapKey for Correction {
     fn name(self) -> &'static str {
         match self {
             Correction::Off => "off",
@@ -225,31 +225,22 @@ impl Stage for InteriorLiquidMap {
         let points = pool.install(|| map(p))?;
         let csv = "interior_liquid_map.csv";
         write_points(&ctx.out_dir.join(csv), &points)?;
-        let ticks = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<String>>();
-        let index = |v: &[f64], x: f64| v.iter().position(|&w| w == x).unwrap_or(0);
-        let (mut figures, mut files) = (Vec::new(), vec![PathBuf::from(csv)]);
-        for c in [Correction::Off, Correction::On] {
-            let file = format!("interior_liquid_map_{}.png", c.name());
-            let cells = points.iter().filter(|q| q.correction == c).map(|q| {
-                (
-                    index(&p.ratios, q.ratio),
-                    index(&p.taus, q.tau),
-                    q.class,
-                    q.verdict,
-                )
-            });
-            draw_map(
-                &ctx.out_dir.join(&file),
-                cells,
-                &format!("Settling disk, PSM, interior-liquid correction {}", c.name()),
-                "grain / liquid density ratio rho_S / rho_L",
-                "relaxation time tau",
-                &ticks(&p.ratios),
-                &ticks(&p.taus),
-            )?;
-            figures.push(Figure {
-                path: file.clone().into(),
-                caption: format!(
+        let grid = Grid {
+            xs: &p.ratios,
+            ys: &p.taus,
+            x_label: "grain / liquid density ratio rho_S / rho_L",
+            y_label: "relaxation time tau",
+        };
+        let (figures, mut files) = operator_maps(
+            &ctx.out_dir,
+            "interior_liquid_map",
+            &[Correction::Off, Correction::On],
+            &points,
+            |q| (q.correction, q.ratio, q.tau, q.class, q.verdict),
+            &grid,
+            |c| format!("Settling disk, PSM, interior-liquid correction {}", c.name()),
+            |c| {
+                format!(
                     "PSM disk ({} cells per diameter) settling between two walls (Faxen drag, Re 0.06), the \
                      interior-liquid correction {}, at each density ratio and tau with (rho_S - rho_L) g \
                      held, run whatever the run-time check says. Colour: accurate (terminal velocity within \
@@ -260,10 +251,10 @@ impl Stage for InteriorLiquidMap {
                     c.name(),
                     p.accuracy * 100.0,
                     INTERIOR_LIQUID_MIN_RATIO
-                ),
-            });
-            files.push(file.into());
-        }
+                )
+            },
+        )?;
+        files.insert(0, csv.into());
         let disagree = points
             .iter()
             .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)

@@ -245,19 +245,30 @@ struct Grid<'a> {
     y_label: &'a str,
 }
 
-/// One map per collision operator, `<stem>_<operator>.png` each: every point of that operator
-/// (`at` gives its operator, x, y, class and verdict) on `grid`, coloured by class and marked by
+/// What a map is drawn per: a collision operator, or the interior-liquid correction off and on.
+trait MapKey: Copy + PartialEq {
+    fn name(self) -> &'static str;
+}
+
+impl MapKey for Operator {
+    fn name(self) -> &'static str {
+        Operator::name(self)
+    }
+}
+
+/// One map per key (collision operator, ...), `<stem>_<key>.png` each: every point of that key
+/// (`at` gives its key, x, y, class and verdict) on `grid`, coloured by class and marked by
 /// verdict. The figures and their file names.
 #[allow(clippy::too_many_arguments)]
-fn operator_maps<P>(
+fn operator_maps<K: MapKey, P>(
     out_dir: &std::path::Path,
     stem: &str,
-    ops: &[Operator],
+    ops: &[K],
     points: &[P],
-    at: impl Fn(&P) -> (Operator, f64, f64, Class, Verdict),
+    at: impl Fn(&P) -> (K, f64, f64, Class, Verdict),
     grid: &Grid,
-    title: impl Fn(Operator) -> String,
-    caption: impl Fn(Operator) -> String,
+    title: impl Fn(K) -> String,
+    caption: impl Fn(K) -> String,
 ) -> Result<(Vec<Figure>, Vec<PathBuf>)> {
     let ticks = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<String>>();
     let (x_ticks, y_ticks) = (ticks(grid.xs), ticks(grid.ys));
