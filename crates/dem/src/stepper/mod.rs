@@ -132,6 +132,8 @@ pub struct Stepper {
     wall_near: Vec<u32>,
     wall_ref: Vec<crate::wall::Wall>,
     kick: Vec<Kick>,
+    /// Per bond: what it hands its bodies at this force evaluation (`bonds.rs`).
+    bond_load: Vec<bonds::BondLoad>,
     n_circles: usize,
     n_bodies: usize,
     checked_dt: f64,
