@@ -173,6 +173,11 @@ impl Confinement {
         self.previous = previous;
     }
 
+    /// The zone and its velocities as the last [`Confinement::zone`] drew them.
+    pub fn current_zone(&self) -> (&[u32], &[[f64; 3]]) {
+        (&self.zone, &self.velocities)
+    }
+
     /// The solid zone of an `nx` × `ny` lattice for the present grains and walls, and the
     /// boundary velocities it refers to (lattice units): 0 at rest (outside the membrane),
     /// 1 + k behind plate k, and after those (`Moving`) one per zone node along the membrane.

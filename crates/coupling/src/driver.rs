@@ -29,7 +29,8 @@ pub struct Timing {
     pub coupling: Duration,
     /// Of `coupling`: the grains' circles and motions on the lattice and the solid map.
     pub map: Duration,
-    /// Of `coupling`: the solid zone of a confined liquid (membrane and push-plate).
+    /// Of `coupling`: the solid zone of a confined liquid (membrane and push-plate), as far as
+    /// it outlasts the map (the two are drawn side by side), and handing it to the lattice.
     pub zone: Duration,
 }
 
@@ -100,6 +101,44 @@ pub struct Coupled<T: Real> {
     loads: Vec<Load>,
 }
 
+/// Grain motions and circles in lattice units, then the solid fraction of every cell.
+fn map_grains<T: Real>(
+    sys: &System,
+    u: &CouplingUnits,
+    dry: &[bool],
+    r_hd: f64,
+    motions: &mut Vec<GrainMotion>,
+    circles: &mut Vec<GrainCircle>,
+    fluid: &mut Hydro<T>,
+) -> Result<(), CouplingError> {
+    let b = &sys.bodies;
+    motions.clear();
+    circles.clear();
+    for k in 0..b.len() {
+        let p = u.position_to_lattice([b.pos[k].x, b.pos[k].y]);
+        motions.push(GrainMotion {
+            centre: p,
+            velocity: u.velocity_to_lattice([b.vel[k].x, b.vel[k].y]),
+            omega: u.omega_to_lattice(b.omega[k]),
+        });
+        if dry[k] {
+            continue;
+        }
+        // One sin_cos per grain, not per circle.
+        let (sin, cos) = b.angle[k].sin_cos();
+        for c in b.circle_start[k]..b.circle_start[k + 1] {
+            let off = b.circle_offset[c].rotated_sc(sin, cos);
+            let cp = u.position_to_lattice([b.pos[k].x + off.x, b.pos[k].y + off.y]);
+            circles.push(GrainCircle {
+                body: k as u32,
+                centre: cp,
+                radius: u.length_to_lattice(b.circle_r[c]),
+            });
+        }
+    }
+    fluid.map(circles, motions, r_hd, sys.domain.periodic)
+}
+
 impl<T: Real> Coupled<T> {
     pub fn new(
         fluid: Hydro<T>,
@@ -155,38 +194,6 @@ impl<T: Real> Coupled<T> {
             circles: Vec::new(),
             loads: Vec::new(),
         })
-    }
-
-    /// Grain motions and circles in lattice units, then the solid fraction of every cell.
-    fn map_grains(&mut self) -> Result<(), CouplingError> {
-        let b = &self.sys.bodies;
-        let u = &self.units;
-        self.motions.clear();
-        self.circles.clear();
-        for k in 0..b.len() {
-            let p = u.position_to_lattice([b.pos[k].x, b.pos[k].y]);
-            self.motions.push(GrainMotion {
-                centre: p,
-                velocity: u.velocity_to_lattice([b.vel[k].x, b.vel[k].y]),
-                omega: u.omega_to_lattice(b.omega[k]),
-            });
-            if self.dry[k] {
-                continue;
-            }
-            // One sin_cos per grain, not per circle.
-            let (sin, cos) = b.angle[k].sin_cos();
-            for c in b.circle_start[k]..b.circle_start[k + 1] {
-                let off = b.circle_offset[c].rotated_sc(sin, cos);
-                let cp = u.position_to_lattice([b.pos[k].x + off.x, b.pos[k].y + off.y]);
-                self.circles.push(GrainCircle {
-                    body: k as u32,
-                    centre: cp,
-                    radius: u.length_to_lattice(b.circle_r[c]),
-                });
-            }
-        }
-        let periodic = self.sys.domain.periodic;
-        self.fluid.map(&self.circles, &self.motions, self.r_hd, periodic)
     }
 
     /// Confine the liquid to the membrane minus the regions behind the walls `plates` (Su et
@@ -286,11 +293,32 @@ impl<T: Real> Coupled<T> {
     /// One LBM cycle and `ratio` DEM cycles.
     pub fn step(&mut self) -> Result<(), CouplingError> {
         let t0 = Instant::now();
-        self.map_grains()?;
-        let t_map = Instant::now();
+        // The solid map and the solid zone read the grains and write apart: side by side (each
+        // is mostly serial work), with the same results as one after the other.
+        let [nx, ny] = self.fluid.size();
+        let (mapped, t_map) = rayon::join(
+            || {
+                let r = map_grains(
+                    &self.sys,
+                    &self.units,
+                    &self.dry,
+                    self.r_hd,
+                    &mut self.motions,
+                    &mut self.circles,
+                    &mut self.fluid,
+                );
+                (r, Instant::now())
+            },
+            || {
+                if let Some(c) = &mut self.confine {
+                    c.zone(&self.sys, &self.units, nx, ny);
+                }
+            },
+        )
+        .0;
+        mapped?;
         if let Some(c) = &mut self.confine {
-            let [nx, ny] = self.fluid.size();
-            let (zone, vel) = c.zone(&self.sys, &self.units, nx, ny);
+            let (zone, vel) = c.current_zone();
             self.fluid.set_zone(zone, vel)?;
             if c.boundary() == MembraneBoundary::Moving {
                 self.membrane_loads.clear();
@@ -338,7 +366,7 @@ impl<T: Real> Coupled<T> {
         let t4 = Instant::now();
         self.timing.coupling += (t1 - t0) + (t3 - t2);
         self.timing.map += t_map - t0;
-        self.timing.zone += t1 - t_map;
+        self.timing.zone += t1 - t_map.min(t1);
         self.timing.lbm += t2 - t1;
         self.timing.dem += t4 - t3;
         Ok(())
