@@ -9,7 +9,8 @@
 //!   beside the run's own series and the mesh's ln J;
 //! - the liquid pressure change field (Eq. 19, Fig. 10) with the cells below Δp_c marked; the
 //!   first crossing of Δp_c (u_y,min) and its site relative to the plate's corners (Sect. 3.5);
-//! - the inertial number (Eq. 20) and the dynamic-dilatancy prediction (Eq. 21);
+//! - the inertial number (Eq. 20) and the dynamic-dilatancy prediction (Eq. 21); the inertial
+//!   number over the shear per output and as Su's one number per run (`inertial.rs`);
 //! - the net class by the rule of `lbdem_analysis::mechanism` (suspension, contraction,
 //!   dilation, cracking), and the packed-zone fraction over time when the run has one (Fig. 5h).
 //!
@@ -30,6 +31,7 @@ use std::path::{Path, PathBuf};
 
 mod figures;
 mod frames;
+mod inertial;
 mod packed;
 
 use figures::{draw_maps, series_figures};
@@ -371,6 +373,15 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
     };
     let site = crossing.and_then(|c| crossing_site(run, c, d_bar, p.pressure_threshold));
     let inertial = run.series("inertial_number").map(|v| median(&v));
+    // Over the shear, per output and Su's one number per run (`inertial.rs`).
+    let inertial_shear = match (
+        run.series("inertial_number"),
+        run.series("mean_stress"),
+        series_u.as_ref(),
+    ) {
+        (Some(i), Some(p), Some(u)) => inertial::summarise(&i, &p, u, run.series("settling").as_deref()),
+        _ => None,
+    };
     let eps_net = run
         .series("eps_vol_dem")
         .and_then(|v| v.last().copied())
@@ -453,6 +464,7 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
             "time_s": c.time, "u_y_min_d": c.u_d, "u_y_before_d": c.u_d_before, "dp_pa": c.dp, "site": site,
         })),
         "dynamic_dilatancy": prediction,
+        "inertial_number": inertial_shear,
         "class": class,
         "class_name": class.map(Class::name),
         "evidence": evidence,
