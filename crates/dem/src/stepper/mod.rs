@@ -413,8 +413,7 @@ impl Stepper {
         let worst = if self.all_disks {
             self.kick_drift_disks(sys, 0.5 * dt, dt)
         } else {
-            self.kick_drift(sys, 0.5 * dt, dt);
-            self.update_circles(sys)
+            self.kick_drift_clumps(sys, 0.5 * dt, dt)
         };
         let half_skin2 = 0.25 * p.skin * p.skin;
         if !worst.is_finite() {
