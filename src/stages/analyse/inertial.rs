@@ -54,11 +54,7 @@ pub fn summarise(i: &[f64], p: &[f64], u_d: &[f64], settling: Option<&[f64]>) ->
         median,
         max: sorted[m - 1],
         share_above_bound: keep.iter().filter(|&&k| i[k] > QUASI_STATIC).count() as f64 / n,
-        last_above_bound_u_d: keep
-            .iter()
-            .rev()
-            .find(|&&k| i[k] > QUASI_STATIC)
-            .map(|&k| u_d[k]),
+        last_above_bound_u_d: keep.iter().rev().find(|&&k| i[k] > QUASI_STATIC).map(|&k| u_d[k]),
         at_mean_stress: i_sqrt_p / mean_p.sqrt(),
     })
 }
