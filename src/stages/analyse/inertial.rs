@@ -5,6 +5,7 @@
 //! rate and grain mass is I ∝ 1/√p', so the one-per-run number is each output's I scaled by
 //! √(p'/p̄'), p̄' the mean over the outputs.
 
+use super::frames::median;
 use serde::Serialize;
 
 /// Su's bound for a quasi-static run (Sect. 3.4: the 1 and 30 µm/s runs "all have I ≤ 0.002").
@@ -37,22 +38,15 @@ pub fn summarise(i: &[f64], p: &[f64], u_d: &[f64], settling: Option<&[f64]>) ->
         return None;
     }
     let n = keep.len() as f64;
-    let mut sorted: Vec<f64> = keep.iter().map(|&k| i[k]).collect();
-    sorted.sort_by(f64::total_cmp);
-    let m = sorted.len();
-    let median = if m % 2 == 1 {
-        sorted[m / 2]
-    } else {
-        0.5 * (sorted[m / 2 - 1] + sorted[m / 2])
-    };
+    let kept: Vec<f64> = keep.iter().map(|&k| i[k]).collect();
     let mean_p = keep.iter().map(|&k| p[k]).sum::<f64>() / n;
     // I √p' is the same at every output (the rate and the mass are fixed): its mean over the
     // outputs, divided by √p̄'.
     let i_sqrt_p = keep.iter().map(|&k| i[k] * p[k].sqrt()).sum::<f64>() / n;
     Some(InertialSummary {
         outputs: keep.len(),
-        median,
-        max: sorted[m - 1],
+        median: median(&kept),
+        max: kept.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         share_above_bound: keep.iter().filter(|&&k| i[k] > QUASI_STATIC).count() as f64 / n,
         last_above_bound_u_d: keep.iter().rev().find(|&&k| i[k] > QUASI_STATIC).map(|&k| u_d[k]),
         at_mean_stress: i_sqrt_p / mean_p.sqrt(),
