@@ -366,7 +366,7 @@ impl<T: Real> Coupled<T> {
         let t4 = Instant::now();
         self.timing.coupling += (t1 - t0) + (t3 - t2);
         self.timing.map += t_map - t0;
-        self.timing.zone += t1 - t_map.min(t1);
+        self.timing.zone += t1 - t_map;
         self.timing.lbm += t2 - t1;
         self.timing.dem += t4 - t3;
         Ok(())
