@@ -62,6 +62,15 @@ pub struct CoupledState<T: Real> {
     /// `Moving` only), which an under-relaxed boundary carries on from.
     #[serde(default)]
     pub membrane_shown: Vec<Vec2>,
+    /// DEM sub-steps per LBM step when the state was taken ([`Coupled::set_ratio`] may have
+    /// changed it from the configuration's; the masses in `sys` went with it). None in
+    /// checkpoints written before 2026-11-30: the configuration's.
+    #[serde(default)]
+    pub ratio: Option<u32>,
+    /// LBM steps taken. None in checkpoints written before 2026-11-30: the DEM steps over the
+    /// ratio, which is right while the ratio never changed.
+    #[serde(default)]
+    pub lbm_steps: Option<u64>,
 }
 
 /// A coupled LBM-DEM run: the lattice, the grains and the scratch of both engines.
@@ -99,6 +108,11 @@ pub struct Coupled<T: Real> {
     motions: Vec<GrainMotion>,
     circles: Vec<GrainCircle>,
     loads: Vec<Load>,
+    /// LBM steps taken (the DEM's step count over the ratio no longer says it once
+    /// [`Coupled::set_ratio`] has changed the ratio).
+    lbm_steps: u64,
+    /// The configuration's ratio and DEM step, which [`Coupled::set_ratio`] returns to exactly.
+    configured: (u32, f64),
 }
 
 /// Grain motions and circles in lattice units, then the solid fraction of every cell.
@@ -171,6 +185,7 @@ impl<T: Real> Coupled<T> {
             )));
         }
         let n = sys.bodies.len();
+        let configured = (units.ratio, units.dt_dem);
         Ok(Self {
             fluid,
             law,
@@ -193,6 +208,8 @@ impl<T: Real> Coupled<T> {
             motions: Vec::new(),
             circles: Vec::new(),
             loads: Vec::new(),
+            lbm_steps: 0,
+            configured,
         })
     }
 
@@ -369,7 +386,48 @@ impl<T: Real> Coupled<T> {
         self.timing.zone += t1 - t_map;
         self.timing.lbm += t2 - t1;
         self.timing.dem += t4 - t3;
+        self.lbm_steps += 1;
         Ok(())
+    }
+
+    /// LBM steps taken.
+    pub fn lbm_steps(&self) -> u64 {
+        self.lbm_steps
+    }
+
+    /// Take `ratio` DEM sub-steps per LBM step from now on, and scale every body's mass and
+    /// inertia by (old ratio / new ratio)², so that the DEM step δt/ratio keeps its margin to the
+    /// critical step (which goes with √m): mass scaling that follows the run (Su Table 3's
+    /// δt/Δt = 100 is the unscaled end of the ladder). Velocities are kept, and so are the DEM's
+    /// contact list and last forces (its scratch refreshes h/m per body when the step or a mass
+    /// changes, and a fresh one continues the same bits: `tests/resume.rs`). Returns the factor
+    /// the masses were scaled by.
+    pub fn set_ratio(&mut self, ratio: u32) -> Result<f64, CouplingError> {
+        if ratio == 0 {
+            return Err(CouplingError::Unsupported(
+                "a DEM-LBM ratio of 0: give at least one DEM step per LBM step".into(),
+            ));
+        }
+        let old = self.units.ratio;
+        if ratio == old {
+            return Ok(1.0);
+        }
+        let factor = (f64::from(old) / f64::from(ratio)).powi(2);
+        self.sys.bodies.scale_mass(factor);
+        self.set_step(ratio);
+        Ok(factor)
+    }
+
+    /// The DEM step δt/ratio in the units and the step parameters, masses untouched (the
+    /// configuration's own step, to the bit, at its ratio).
+    fn set_step(&mut self, ratio: u32) {
+        self.units.ratio = ratio;
+        self.units.dt_dem = if ratio == self.configured.0 {
+            self.configured.1
+        } else {
+            self.units.dt() / f64::from(ratio)
+        };
+        self.params.dt = self.units.dt_dem;
     }
 
     /// Cancel the interior liquid's share of the last load: in this LBM cycle the collision
@@ -431,6 +489,8 @@ impl<T: Real> Coupled<T> {
                 .as_ref()
                 .map(|c| c.shown().to_vec())
                 .unwrap_or_default(),
+            ratio: Some(self.units.ratio),
+            lbm_steps: Some(self.lbm_steps),
         }
     }
 
@@ -449,6 +509,12 @@ impl<T: Real> Coupled<T> {
         state.sys.check_state().map_err(|why| {
             CouplingError::Unsupported(format!("coupled checkpoint: the grains are inconsistent: {why}"))
         })?;
+        if state.ratio == Some(0) {
+            return Err(CouplingError::Unsupported(
+                "coupled checkpoint with 0 DEM steps per LBM step: the file is damaged; write it again"
+                    .into(),
+            ));
+        }
         self.fluid.restore(state.fluid)?;
         self.fluid.restore_mapped(state.mapped, state.sys.domain.periodic);
         self.sys = state.sys;
@@ -461,6 +527,13 @@ impl<T: Real> Coupled<T> {
             c.set_shown(state.membrane_shown);
         }
         self.dry.resize(n, false);
+        // The masses in `sys` are those of the checkpoint's ratio already.
+        if let Some(r) = state.ratio {
+            self.set_step(r);
+        }
+        self.lbm_steps = state
+            .lbm_steps
+            .unwrap_or(self.sys.step / u64::from(self.units.ratio));
         self.dem = Stepper::new();
         Ok(())
     }
