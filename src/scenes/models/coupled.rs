@@ -7,6 +7,7 @@
 
 use super::contact_list;
 use super::dry::{grain_columns, grain_sample};
+use super::mass_control::MassControl;
 use super::packed_zone::{self, PackedZone};
 use super::shear_cell::{self, Origin, Tracked};
 use crate::scenes::build::dem::wall_anchor;
@@ -51,6 +52,8 @@ pub struct CoupledModel<T: Real> {
     cell: Option<Tracked>,
     /// The packed layer of `[packed_zone]`.
     zone: Option<PackedZone>,
+    /// The mass scale that follows the inertial number (`[dem.mass_scale_control]`).
+    mass_control: Option<MassControl>,
     /// Liquid mass at the start (kg; the liquid inside the sample when it is confined).
     liquid_mass0: f64,
     /// ρ_0 of Su Eq. 19 (lattice units): 1 at the start, the liquid nodes' mean density when
@@ -187,8 +190,23 @@ impl<T: Real> CoupledModel<T> {
                 run.dry[k] = run.sys.bodies.tag[k] == 1;
             }
         }
+        let mass_control = match &dem.mass_scale_control {
+            None => None,
+            Some(c) => {
+                if s.shear_cell.is_none() {
+                    bail!(
+                        "[dem.mass_scale_control] follows the inertial number of a shear cell (Su Eq. 20), which                          needs [shear_cell]; remove the control or add the cell"
+                    );
+                }
+                Some(MassControl::new(c, dem.mass_scale, run.units.ratio)?)
+            }
+        };
         if cs.method == Method::Psm {
-            light_grains(&run, s)?;
+            // The lightest grains the run may reach: the bottom of the ladder.
+            let lightest = mass_control
+                .as_ref()
+                .map_or(dem.mass_scale, MassControl::smallest_scale);
+            light_grains(&run, s, lightest)?;
         }
         if cs.interior_liquid_correction {
             run = run
@@ -238,6 +256,7 @@ impl<T: Real> CoupledModel<T> {
             pool,
             cell,
             zone: PackedZone::new(s)?,
+            mass_control,
             liquid_mass0: 0.0,
             rho0: 1.0,
         };
@@ -343,10 +362,22 @@ impl<T: Real> Model for CoupledModel<T> {
                 self.rho0 = self.mean_liquid_density();
             }
         }
+        // The shear's inertial number: none while the plate is held (the settling keeps the
+        // scene's scale).
+        if let (Some(mc), Some(c)) = (&self.mass_control, &self.cell)
+            && steps.is_multiple_of(mc.every)
+            && !c.settling(steps)
+        {
+            let i = c.cell.inertial_now(&self.run.sys, self.run.dem_stepper());
+            let r = mc.choose(self.run.units.ratio, i);
+            self.run
+                .set_ratio(r)
+                .map_err(|e| anyhow::anyhow!("[dem.mass_scale_control]: {e}"))?;
+        }
         Ok(())
     }
     fn steps_done(&self) -> u64 {
-        self.run.sys.step / u64::from(self.run.units.ratio)
+        self.run.lbm_steps()
     }
     fn time(&self) -> f64 {
         self.steps_done() as f64 * self.run.units.dt()
@@ -379,6 +410,9 @@ impl<T: Real> Model for CoupledModel<T> {
         }
         if self.zone.is_some() {
             c.extend(packed_zone::COLUMNS.map(String::from));
+        }
+        if self.mass_control.is_some() {
+            c.extend(["dem_steps_per_lbm_step", "mass_scale"].map(String::from));
         }
         c
     }
@@ -422,6 +456,9 @@ impl<T: Real> Model for CoupledModel<T> {
         }
         if let Some(z) = &self.zone {
             v.extend(z.sample(&run.sys));
+        }
+        if let Some(mc) = &self.mass_control {
+            v.extend([f64::from(u.ratio), mc.scale(u.ratio)]);
         }
         v
     }
@@ -565,18 +602,24 @@ fn damped_membrane(s: &Scene) -> Result<()> {
 /// liquid's density (its inertia, mass scaling included): the explicit coupling blows up there
 /// (docs/stability.md, "Near-neutral grains"). Warn below [`PSM_DENSITY_RATIO_WARN`], above the
 /// highest ratio at which the settling disk of the interior-liquid map blew up.
-fn light_grains<T: Real>(run: &Coupled<T>, s: &Scene) -> Result<()> {
-    let lightest = run.lightest_wet_density();
+fn light_grains<T: Real>(run: &Coupled<T>, s: &Scene, scale: f64) -> Result<()> {
+    let at = s.dem.as_ref().map_or(1.0, |d| d.mass_scale);
+    let lightest = run.lightest_wet_density() * scale / at;
     let ratio = lightest / run.liquid_density();
     let density = s.particles.as_ref().map_or(0.0, |p| p.density);
-    let scale = s.dem.as_ref().map_or(1.0, |d| d.mass_scale);
+    // The scale checked is the bottom of a mass-scale ladder when there is one.
+    let key = if scale == at {
+        "[dem] mass_scale"
+    } else {
+        "[dem.mass_scale_control] smallest"
+    };
     if ratio < PSM_DENSITY_RATIO_MIN {
         let need = scale * 1.1 * PSM_DENSITY_RATIO_MIN / ratio;
         bail!(
-            "[particles] density = {density} kg/m² with [dem] mass_scale = {scale} over [coupling] depth = {} m \
+            "[particles] density = {density} kg/m² with {key} = {scale} over [coupling] depth = {} m \
              makes the lightest wet grain {lightest:.1} kg/m³, {ratio:.3} times the liquid's {} kg/m³; below \
              {PSM_DENSITY_RATIO_MIN} the explicit PSM coupling blows up (the reduced shear cell did at 0.45, \
-             docs/stability.md). Raise [dem] mass_scale to at least {need:.3} (a quasi-static run allows it) \
+             docs/stability.md). Raise {key} to at least {need:.3} (a quasi-static run allows it) \
              or the grains' density",
             run.depth,
             run.liquid_density()
@@ -586,7 +629,7 @@ fn light_grains<T: Real>(run: &Coupled<T>, s: &Scene) -> Result<()> {
         eprintln!(
             "coupled: warning: the lightest wet grain is {ratio:.3} times the liquid's density; the reduced \
              shear cell ran from 0.56 (accurate from 0.68), but a disk settling in open liquid blew up up to \
-             0.8 and ran from 0.9 (docs/stability.md, \"Near-neutral grains\"): raise [dem] mass_scale to \
+             0.8 and ran from 0.9 (docs/stability.md, \"Near-neutral grains\"): raise {key} to \
              {:.3} or more if the run is quasi-static",
             scale * PSM_DENSITY_RATIO_WARN / ratio
         );

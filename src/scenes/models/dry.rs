@@ -34,7 +34,14 @@ impl Dry {
         let mut sys = super::grains(s, base)?;
         let law = s.contact.clone().context("[contact] is required")?;
         let wall_law = s.wall_contact.clone().unwrap_or_else(|| law.clone());
-        let params = s.dem.as_ref().context("[dem] is required")?.step_params();
+        let dem = s.dem.as_ref().context("[dem] is required")?;
+        if dem.mass_scale_control.is_some() {
+            anyhow::bail!(
+                "[dem.mass_scale_control] changes the DEM step with the LBM-DEM ratio of a coupled scene; a dry \
+                 scene has no LBM step to keep: remove it and give [dem] mass_scale"
+            );
+        }
+        let params = dem.step_params();
         let (crit, m_min, k_max) = Stepper::critical_time_step(&sys, &law, &wall_law);
         if !crate::contract::quiet() {
             eprintln!(

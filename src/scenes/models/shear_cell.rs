@@ -42,9 +42,8 @@ pub struct ShearCell {
     order: Vec<usize>,
     /// γ̇ of Eq. 20 (1/s).
     shear_rate: f64,
-    /// Mean equivalent-area grain diameter d̄ (m) and mean grain density (kg/m², per depth).
+    /// Mean equivalent-area grain diameter d̄ (m).
     pub d_mean: f64,
-    rho: f64,
 }
 
 /// Move the push-plate back along its motion until no grain circle overlaps it, before the
@@ -132,7 +131,6 @@ impl ShearCell {
             .map(|k| (4.0 * b.mass[k] / b.density[k] / std::f64::consts::PI).sqrt())
             .sum::<f64>()
             / n;
-        let rho = b.density.iter().sum::<f64>() / n;
         Ok(Some(Self {
             plate,
             dir: v * (1.0 / v.norm()),
@@ -140,7 +138,6 @@ impl ShearCell {
             order: mem.ring_order(),
             shear_rate: v.norm() / sc.shear_length,
             d_mean,
-            rho,
         }))
     }
 
@@ -171,13 +168,28 @@ impl ShearCell {
 
     /// Inertial number I = γ̇ d̄ √(ρ/p') (Eq. 20 in the form of da Cruz et al. 2005, Su's ref.
     /// [120]; Su's γ̇ √(m_grain/P) with m_grain = ¼ρπd̄² is the same up to √(π/4) and the 2D
-    /// units). NaN while the grains carry no stress.
-    pub fn inertial_number(&self, p: f64) -> f64 {
+    /// units), ρ the grains' mean density (kg/m², per depth) as the DEM steps them (mass
+    /// scaling included, which `[dem.mass_scale_control]` changes during the run). NaN while
+    /// the grains carry no stress.
+    pub fn inertial_number(&self, p: f64, rho: f64) -> f64 {
         if p > 0.0 {
-            self.shear_rate * self.d_mean * (self.rho / p).sqrt()
+            self.shear_rate * self.d_mean * (rho / p).sqrt()
         } else {
             f64::NAN
         }
+    }
+
+    /// The grains' mean density as the DEM steps them (kg/m², per depth).
+    fn density(sys: &System) -> f64 {
+        let b = &sys.bodies;
+        b.density.iter().sum::<f64>() / b.len().max(1) as f64
+    }
+
+    /// The inertial number of the grains as they stand (the sample's area, p' and I of
+    /// [`ShearCell::sample`]).
+    pub fn inertial_now(&self, sys: &System, st: &Stepper) -> f64 {
+        let p = Self::mean_stress(sys, st, self.area(sys));
+        self.inertial_number(p, Self::density(sys))
     }
 
     /// The plate's displacement along its motion (m) since `start`.
@@ -210,7 +222,7 @@ impl ShearCell {
             a,
             (a / a0).ln(),
             p,
-            self.inertial_number(p),
+            self.inertial_number(p, Self::density(sys)),
         ]
     }
 }

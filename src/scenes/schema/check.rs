@@ -249,6 +249,21 @@ const RULES: &[Rule] = &[
     ),
     Rule("dem.local_damping", Need::BelowOne, "local (Cundall) damping"),
     Rule("dem.mass_scale", Need::Positive, "mass scaling factor (1 = none)"),
+    Rule(
+        "dem.mass_scale_control.inertial_number",
+        Need::Between(0.0, 1.0),
+        "largest scaled inertial number (Su Sect. 3.4: 0.002)",
+    ),
+    Rule(
+        "dem.mass_scale_control.smallest",
+        Need::Positive,
+        "smallest mass scale (1 = the grains' own masses)",
+    ),
+    Rule(
+        "dem.mass_scale_control.every",
+        Need::Positive,
+        "LBM steps between two choices of the mass scale",
+    ),
     Rule("compress.target_stress", Need::Positive, "target 2D stress (N/m)"),
     Rule("compress.alpha", Need::Positive, "servo gain"),
     Rule("compress.v_max", Need::Positive, "largest wall speed (m/s)"),

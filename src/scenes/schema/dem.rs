@@ -153,6 +153,32 @@ pub struct DemSection {
     /// number (Su Eq. 20) the series reports is the scaled run's, √factor times the real one.
     #[serde(default = "one")]
     pub mass_scale: f64,
+    /// Mass scaling that follows the run (`[dem.mass_scale_control]`): `mass_scale` and `dt`
+    /// are then the largest scale and its step, and the run takes the largest scale that keeps
+    /// the scaled inertial number under a target. Coupled shear-cell scenes only.
+    #[serde(default)]
+    pub mass_scale_control: Option<MassScaleControl>,
+}
+
+/// `[dem.mass_scale_control]`: the mass scale follows the inertial number (Su Eq. 20) of the
+/// run (issue 13 item 7; `scenes::models::mass_control`). The scale moves on a ladder of whole
+/// DEM-LBM ratios r, the scale at r being `mass_scale` × (r_0/r)² (r_0 the scene's ratio), so
+/// every rung keeps the scene's margin to the critical step.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassScaleControl {
+    /// Keep the scaled inertial number under this (Su Sect. 3.4: quasi-static below 0.002).
+    pub inertial_number: f64,
+    /// The smallest mass scale the ladder goes down to (default 1: the grains' own masses).
+    #[serde(default = "one")]
+    pub smallest: f64,
+    /// LBM steps between two decisions (default 20).
+    #[serde(default = "twenty")]
+    pub every: u64,
+}
+
+fn twenty() -> u64 {
+    20
 }
 
 impl DemSection {

@@ -21,8 +21,8 @@ pub mod simplify;
 
 pub use coupling::CouplingSection;
 pub use dem::{
-    BondsSection, CompressSection, DemSection, GenerateSection, MembraneSection, ParticlesSection,
-    TemplateSection, WallSection,
+    BondsSection, CompressSection, DemSection, GenerateSection, MassScaleControl, MembraneSection,
+    ParticlesSection, TemplateSection, WallSection,
 };
 pub use extruder::{ExtruderSection, NessLaw, SuspensionSection};
 pub use fluid::{

@@ -242,3 +242,24 @@ fn the_windowed_stop_ends_at_the_first_still_window_and_resumes_to_the_same_bits
         assert!(x == y, "{f} differs after {interruptions} interruptions");
     }
 }
+
+/// `[dem.mass_scale_control]` moves the DEM step with the LBM-DEM ratio; a dry scene has no
+/// LBM step, and is refused before anything is written.
+#[test]
+fn a_dry_scene_refuses_a_mass_scale_that_follows_the_run() {
+    let t = tempfile::tempdir().unwrap();
+    let text = SCENE.replace(
+        "[run]\n",
+        "[dem.mass_scale_control]\ninertial_number = 0.002\n[run]\n",
+    );
+    assert!(text.contains("[dem.mass_scale_control]"));
+    let e = format!("{:#}", simulate(&text, t.path(), false).unwrap_err());
+    assert!(
+        e.contains("a dry scene has no LBM step") && e.contains("remove it"),
+        "{e}"
+    );
+    assert!(
+        !t.path().join("out").exists(),
+        "the refused run left output behind"
+    );
+}

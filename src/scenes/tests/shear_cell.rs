@@ -360,6 +360,41 @@ fn resumes_to_the_same_bits(edit: impl Fn(String) -> String) {
     assert!(a == b, "the last fluid snapshot differs");
 }
 
+/// The same with the mass scale following the inertial number (`[dem.mass_scale_control]`):
+/// the checkpoint carries the ratio the run had reached (the masses in the grains went with it)
+/// and the LBM step count, which the DEM's step count no longer gives.
+#[test]
+fn an_interrupted_run_whose_mass_scale_follows_the_inertial_number_resumes_to_the_same_bits() {
+    let t = tempfile::tempdir().unwrap();
+    let probe = t.path().join("probe");
+    // The run below, uninterrupted, must leave the scene's ratio after the settling and before
+    // most checkpoints (every 5 LBM steps), so that the resumed runs start from a ratio the
+    // scene does not give (measured: 25 to the settling's end, 125 from the first choice on).
+    let text = cell(&probe, |s| {
+        following("4.0e-4", 5)(settled("0.006")(shorter("0.03")(s)))
+    });
+    simulate(&text, &probe, false).unwrap();
+    let ratios = column(&probe.join("out"), "dem_steps_per_lbm_step");
+    let first = ratios.iter().position(|&r| r != 25.0);
+    assert!(first.is_some_and(|k| k < ratios.len() / 2), "ratios {ratios:?}");
+    resumes_to_the_same_bits(following("4.0e-4", 5));
+}
+
+/// The reduced cell at mass scale 25 (DEM step 2e-5 s, 25 DEM steps per LBM step: the top of
+/// the ladder), its scale following the inertial number with target `target`, chosen every
+/// `every` LBM steps.
+fn following(target: &'static str, every: u32) -> impl Fn(String) -> String {
+    move |s: String| {
+        s.replace("dt = 4.0e-6", "dt = 2.0e-5\nmass_scale = 25.0")
+            .replace(
+                "[fluid]\n",
+                &format!(
+                    "[dem.mass_scale_control]\ninertial_number = {target}\nevery = {every}\n\n[fluid]\n"
+                ),
+            )
+    }
+}
+
 /// The plate held for `time` seconds before it moves (`[shear_cell] settle`), and a snapshot as
 /// it starts to move.
 fn settled(time: &str) -> impl Fn(String) -> String {
@@ -653,6 +688,79 @@ fn mass_scaling_by_ten_leaves_the_strain_and_the_plate_force_unchanged() {
         i_end < 1e-3 && i_end > *a.inertial.last().unwrap(),
         "inertial numbers {:?}",
         (a.inertial.last(), i_end)
+    );
+}
+
+/// A mass scale that follows the inertial number (`[dem.mass_scale_control]`, issue 13 item 7)
+/// on the reduced cell: from scale 25 at the top, down to the grains' own masses (Table 3's
+/// ratio here, 125) while the scaled I is over the target, up again where it stays well under
+/// it. Every output either keeps the scaled I under the target or sits on the bottom rung, and
+/// what the run records stays within a few per cent of the paper's own steps.
+#[test]
+fn a_mass_scale_that_follows_the_inertial_number_keeps_it_quasi_static_and_the_results() {
+    let t = tempfile::tempdir().unwrap();
+    let b = measured(t.path(), following("4.0e-4", 10));
+    let out = t.path().join("out");
+    let (ratio, scale) = (column(&out, "dem_steps_per_lbm_step"), column(&out, "mass_scale"));
+    // The run went down to the bottom rung (the plate's first strokes, unscaled I about 2e-3 at
+    // 2.5 mm/s) and came back up part of the way (measured: ratio 125, then 69 to 46, scales
+    // 1 and 3.3 to 7.4).
+    assert!(ratio.contains(&125.0), "ratios {ratio:?}");
+    assert!(ratio.iter().any(|&r| r > 25.0 && r < 125.0), "ratios {ratio:?}");
+    for ((&r, &m), &i) in ratio.iter().zip(&scale).zip(&b.inertial) {
+        // The scale is the scene's 25 x (25 / r)^2 ...
+        assert!((m - 25.0 * (25.0 / r).powi(2)).abs() < 1e-12 * m, "{r} {m}");
+        // ... and the scaled I under 4e-4 wherever the ladder had a lighter rung to give; the
+        // outputs fall between two choices, so up to 10 % over (measured: at most 3.2e-4 off
+        // the bottom rung).
+        assert!(r == 125.0 || i <= 4.4e-4, "I = {i} at ratio {r}");
+    }
+    let a = paper_steps();
+    eprintln!("mass scale following I: {a:?} and {b:?}");
+    // Measured (2026-11-30): ε_vol^DEM 0.014746 and 0.014807 (0.41 %), plate force 0.010662 and
+    // 0.010898 N (2.2 %), profiles at most 0.69 µm apart (0.20 % of u_y = 351 µm): closer than
+    // the fixed scale 10 (the note above), as the scale here stays under 7.4. Tolerances are
+    // twice these; like the others they may need measuring again when a change moves the chaos.
+    assert_within(a, &b, 0.009, 0.045, 0.004);
+}
+
+/// What `[dem.mass_scale_control]` refuses before anything runs: a smallest scale above the
+/// scene's, a ladder of one rung, a scene without a shear cell to measure I in, a dry scene.
+#[test]
+fn a_mass_scale_control_without_a_ladder_or_an_inertial_number_is_refused() {
+    let t = tempfile::tempdir().unwrap();
+    let dir = t.path();
+    let text = cell(dir, |s| {
+        following("4.0e-4", 10)(s).replace("every = 10\n", "every = 10\nsmallest = 30.0\n")
+    });
+    assert_refused(
+        simulate(&text, dir, false),
+        "smallest = 30",
+        "give a smaller one",
+        dir,
+    );
+    let text = cell(dir, |s| {
+        following("4.0e-4", 10)(s).replace("every = 10\n", "every = 10\nsmallest = 24.0\n")
+    });
+    assert_refused(
+        simulate(&text, dir, false),
+        "no other rung",
+        "give a smaller smallest scale",
+        dir,
+    );
+    let text = cell(dir, |s| {
+        // Without the cell the plate must stand still: the liquid sees a moving wall only as a
+        // confined sample's push-plate.
+        following("4.0e-4", 10)(s)
+            .replace("[shear_cell]\nplate = \"plate\"\n", "")
+            .replace("velocity = [0.0, 2.5e-3]\n", "")
+    });
+    assert!(!text.contains("[shear_cell]"));
+    assert_refused(
+        simulate(&text, dir, false),
+        "needs [shear_cell]",
+        "add the cell",
+        dir,
     );
 }
 
