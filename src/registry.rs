@@ -56,6 +56,7 @@ pub static STAGES: &[StageKind] = &[
         &["interior-liquid-map"],
         CliShape::ParamsFile,
     ),
+    entry::<stages::stability_map::dense_psm::DensePsmMap>(&["dense-psm-map"], CliShape::ParamsFile),
     entry::<stages::report::Report>(&["report"], CliShape::ParamsFile),
     entry::<stages::analyse::Analyse>(&["analyse"], CliShape::ParamsFile),
     entry::<stages::synth_run::SynthRun>(&["synth", "run"], CliShape::ParamsFile),

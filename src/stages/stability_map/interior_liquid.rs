@@ -9,7 +9,7 @@
 //! inaccurate, or blown up (stopped by the engine's limits). What the run-time checks of a coupled
 //! scene say of the same grain ([`verdict`]) is recorded beside each point.
 
-use super::{Class, Grid, MapKey, Verdict, operator_maps};
+use super::{Class, Grid, Verdict, operator_maps};
 use crate::contract::{Stage, StageContext, StageOutput, Table};
 use crate::report::table::{Col, write_table};
 use anyhow::{Result, anyhow, bail};
@@ -70,12 +70,18 @@ pub enum Correction {
     On,
 }
 
-impl super::MapKey for Correction {
+impl Correction {
     fn name(self) -> &'static str {
         match self {
             Correction::Off => "off",
             Correction::On => "on",
         }
+    }
+}
+
+impl super::MapKey for Correction {
+    fn name(self) -> String {
+        Correction::name(self).into()
     }
 }
 

@@ -7,6 +7,7 @@
 
 pub mod bingham;
 pub mod dem;
+pub mod dense_psm;
 pub mod free_surface;
 pub mod interior_liquid;
 pub mod lbm;
@@ -245,14 +246,15 @@ struct Grid<'a> {
     y_label: &'a str,
 }
 
-/// What a map is drawn per: a collision operator, or the interior-liquid correction off and on.
+/// What a map is drawn per: a collision operator, the interior-liquid correction off and on,
+/// a resolution.
 trait MapKey: Copy + PartialEq {
-    fn name(self) -> &'static str;
+    fn name(self) -> String;
 }
 
 impl MapKey for Operator {
-    fn name(self) -> &'static str {
-        Operator::name(self)
+    fn name(self) -> String {
+        Operator::name(self).into()
     }
 }
 
