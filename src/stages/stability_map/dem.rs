@@ -3,8 +3,9 @@
 //! twentieth of the critical step sqrt(m_min/k_max) to several times it, forced past the stepper's
 //! refusal; its coefficient of restitution is compared with a converged run's (dt = dt_crit/200)
 //! and each run classed accurate, inaccurate or blown up, beside what the stepper's check says.
-//! A last row runs a compressed triangular packing (`lbdem_dem::cases::packing`), whose energy
-//! drift shows what six contacts per grain do to the limit.
+//! The last rows run a compressed triangular packing (`lbdem_dem::cases::packing`), whose energy
+//! drift shows what six contacts per grain do to the limit (linear and Hertz laws), and whose
+//! late kinetic energy does under the elastic-plastic law, which does not conserve energy.
 
 use super::{Class, Verdict, draw_map};
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
@@ -138,6 +139,20 @@ pub fn map(laws: &[Law], ratios: &[f64], speed: f64, accuracy: f64) -> Result<Ve
         (PACKING, packing::PackingLaw::Linear),
         (PACKING_HERTZ, packing::PackingLaw::Hertz),
     ];
+    // The elastic-plastic packing dissipates: its runs are judged by the kinetic energy left in
+    // their second half against a run at dt_crit/50.
+    let reference = packing::run_law(
+        packing::PackingLaw::Plastic,
+        PACKING_K,
+        8,
+        8,
+        0.02,
+        100.0,
+        false,
+        1,
+    )
+    .map_err(|e| anyhow!("dem-step-map: the {PACKING_PLASTIC} at dt/dt_crit = 0.02: {e}"))?
+    .late_kinetic;
     for (name, law) in &packings {
         for &ratio in ratios {
             let d = packing::run_law(*law, PACKING_K, 8, 8, ratio, 100.0, true, 1)
@@ -166,6 +181,42 @@ pub fn map(laws: &[Law], ratios: &[f64], speed: f64, accuracy: f64) -> Result<Ve
             });
         }
     }
+    for &ratio in ratios {
+        let d = packing::run_law(
+            packing::PackingLaw::Plastic,
+            PACKING_K,
+            8,
+            8,
+            ratio,
+            100.0,
+            true,
+            1,
+        )
+        .map_err(|e| anyhow!("dem-step-map: the {PACKING_PLASTIC} at dt/dt_crit = {ratio}: {e}"))?;
+        let error = (d.late_kinetic - reference).abs() / reference;
+        points.push(Point {
+            law: PACKING_PLASTIC.into(),
+            ratio,
+            verdict: if ratio > ACCEPTED_FRACTION {
+                Verdict::Refused
+            } else {
+                Verdict::Accepted
+            },
+            // Blown up past 100 initial kinetic energies, as the conservative rows.
+            class: if !(d.late_kinetic <= 100.0) {
+                Class::BlownUp
+            } else if error < PLASTIC_ACCURACY {
+                Class::Accurate
+            } else {
+                Class::Inaccurate
+            },
+            restitution: f64::NAN,
+            reference: f64::NAN,
+            max_overlap: f64::NAN,
+            energy_error: error,
+            steps: d.steps,
+        });
+    }
     Ok(points)
 }
 
@@ -177,6 +228,12 @@ const PACKING_HERTZ: &str = "hertz, packing";
 const PACKING_K: f64 = 1e4;
 /// Largest energy error (over the initial kinetic energy) of an accurate packing run.
 const PACKING_ACCURACY: f64 = 0.05;
+/// The same packing under Su's elastic-plastic law (`packing::plastic`: yield at half the
+/// lattice's contact force), judged by the kinetic energy of the run's second half.
+const PACKING_PLASTIC: &str = "plastic, packing";
+/// Largest relative difference of that kinetic energy from the run at dt_crit/50 for an
+/// accurate run.
+const PLASTIC_ACCURACY: f64 = 0.1;
 
 pub struct DemStepMap;
 
@@ -230,6 +287,7 @@ impl Stage for DemStepMap {
         let mut names: Vec<String> = p.laws.iter().map(|l| l.name().to_string()).collect();
         names.push(PACKING.into());
         names.push(PACKING_HERTZ.into());
+        names.push(PACKING_PLASTIC.into());
         let cells = points.iter().map(|q| {
             let ix = p.ratios.iter().position(|&r| r == q.ratio).unwrap_or(0);
             let iy = names.iter().position(|n| *n == q.law).unwrap_or(0);
@@ -251,10 +309,11 @@ impl Stage for DemStepMap {
                 path: "dem_step_map.png".into(),
                 caption: format!(
                     "Two disks meeting head on at {} m/s, per contact law, and a compressed triangular packing of \
-                     64 disks (linear and Hertz laws, undamped), at each dt/dt_crit, run whatever the stepper's check says. \
+                     64 disks (linear, Hertz and elastic-plastic laws, undamped), at each dt/dt_crit, run whatever the stepper's check says. \
                      Colour: accurate (restitution within {} % of the run at dt_crit/200; packing: energy error \
-                     below 5 % of the initial kinetic energy), inaccurate, blown up. A cross where the stepper \
-                     refuses the step.",
+                     below 5 % of the initial kinetic energy; elastic-plastic packing: the second half's kinetic \
+                     energy within 10 % of the run at dt_crit/50), inaccurate, blown up. A cross where the \
+                     stepper refuses the step.",
                     p.speed,
                     p.accuracy * 100.0
                 ),
@@ -277,8 +336,11 @@ mod tests {
     #[test]
     fn the_critical_step_check_agrees_with_the_map() {
         let pts = map(&laws(), &ratios(), speed(), accuracy()).unwrap();
-        assert_eq!(pts.len(), 5 * 15);
-        for q in pts.iter().filter(|q| q.law != PACKING && q.law != PACKING_HERTZ) {
+        assert_eq!(pts.len(), 6 * 15);
+        for q in pts
+            .iter()
+            .filter(|q| ![PACKING, PACKING_HERTZ, PACKING_PLASTIC].contains(&q.law.as_str()))
+        {
             let what = format!("{q:?}");
             // A step the stepper accepts never blows up a colliding pair. Up to dt_crit/2 it is
             // accurate (largest restitution error measured 1.2 %, plastic at 0.5); from 0.7 the
@@ -329,6 +391,21 @@ mod tests {
                 (q.ratio, q.class, q.verdict, q.energy_error, q.steps)
             );
         }
+        // The elastic-plastic packing (every contact yields at the first step; judged by the
+        // kinetic energy of the run's second half against dt_crit/50): measured 2.2e-4 off at
+        // 0.05, 0.029 at 0.3, 0.080 at 0.5, 0.17 at 0.7; the refused 0.9 and 1.0 end with 53 and
+        // 77 initial kinetic energies (590 and 860 times the reference) and 1.1 onwards with
+        // more than 100 (blown up): the yield caps the runaway, so its edge lies past the
+        // linear lattice's 0.9, as Hertz's does.
+        for q in pts.iter().filter(|q| q.law == PACKING_PLASTIC) {
+            let what = format!("{q:?}");
+            let want = match q.ratio {
+                r if r <= 0.5 => Class::Accurate,
+                r if r <= 1.0 => Class::Inaccurate,
+                _ => Class::BlownUp,
+            };
+            assert_eq!(q.class, want, "{what}");
+        }
         let accepted_blown = pts
             .iter()
             .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)
@@ -342,7 +419,7 @@ mod tests {
         let ctx = StageContext::new(dir.path().to_path_buf(), "dem".into(), dir.path().to_path_buf());
         let p: Params = toml::from_str("ratios = [0.1, 1.2, 3.0]").unwrap();
         let out = DemStepMap::run(&p, &ctx).unwrap();
-        assert_eq!(out.summary["points"].as_array().unwrap().len(), 15);
+        assert_eq!(out.summary["points"].as_array().unwrap().len(), 18);
         assert!(dir.path().join("dem_step_map.png").exists());
         let bad: Params = toml::from_str("ratios = [-1.0]").unwrap();
         let e = DemStepMap::run(&bad, &ctx).unwrap_err().to_string();
