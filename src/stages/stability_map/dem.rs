@@ -203,7 +203,7 @@ pub fn map(laws: &[Law], ratios: &[f64], speed: f64, accuracy: f64) -> Result<Ve
                 Verdict::Accepted
             },
             // Blown up past 100 initial kinetic energies, as the conservative rows.
-            class: if !(d.late_kinetic <= 100.0) {
+            class: if d.late_kinetic.is_nan() || d.late_kinetic > 100.0 {
                 Class::BlownUp
             } else if error < PLASTIC_ACCURACY {
                 Class::Accurate
