@@ -195,7 +195,8 @@ impl<T: Real> CoupledModel<T> {
             Some(c) => {
                 if s.shear_cell.is_none() {
                     bail!(
-                        "[dem.mass_scale_control] follows the inertial number of a shear cell (Su Eq. 20), which                          needs [shear_cell]; remove the control or add the cell"
+                        "[dem.mass_scale_control] follows the inertial number of a shear cell (Su Eq. 20), which \
+                         needs [shear_cell]; remove the control or add the cell"
                     );
                 }
                 Some(MassControl::new(c, dem.mass_scale, run.units.ratio)?)
