@@ -379,7 +379,13 @@ fn analyse(p: &Params, run: &Run, ctx: &StageContext) -> Result<StageOutput> {
         run.series("mean_stress"),
         series_u.as_ref(),
     ) {
-        (Some(i), Some(p), Some(u)) => inertial::summarise(&i, &p, u, run.series("settling").as_deref()),
+        (Some(i), Some(p), Some(u)) => inertial::summarise(
+            &i,
+            &p,
+            u,
+            run.series("settling").as_deref(),
+            run.series("mass_scale").as_deref(),
+        ),
         _ => None,
     };
     let eps_net = run
