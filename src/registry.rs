@@ -51,6 +51,10 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::stability_map::StabilityMap>(&["stability-map"], CliShape::ParamsFile),
     entry::<stages::stability_map::dem::DemStepMap>(&["dem-step-map"], CliShape::ParamsFile),
     entry::<stages::stability_map::bingham::BinghamMap>(&["bingham-map"], CliShape::ParamsFile),
+    entry::<stages::stability_map::bingham_floor::BinghamFloorMap>(
+        &["bingham-floor-map"],
+        CliShape::ParamsFile,
+    ),
     entry::<stages::stability_map::free_surface::FreeSurfaceMap>(&["free-surface-map"], CliShape::ParamsFile),
     entry::<stages::stability_map::interior_liquid::InteriorLiquidMap>(
         &["interior-liquid-map"],

@@ -104,7 +104,7 @@ pub struct Point {
 
 /// The stricter of the rheology's refusals and the lattice check on the plastic viscosity at
 /// the plug speed.
-fn verdict(case: &Case, operator: Operator) -> Verdict {
+pub(super) fn verdict(case: &Case, operator: Operator) -> Verdict {
     if case.bingham().check().is_err() {
         return Verdict::Refused;
     }

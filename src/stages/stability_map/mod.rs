@@ -6,6 +6,7 @@
 //! setting. Writes the CSV and one PNG map per collision; `docs/stability.md` reads them.
 
 pub mod bingham;
+pub mod bingham_floor;
 pub mod dem;
 pub mod dense_psm;
 pub mod free_surface;
