@@ -74,6 +74,60 @@ pub fn write_table(path: &Path, columns: &[(&str, Col)]) -> Result<()> {
     write_frame(path, &mut DataFrame::new(height, cols)?)
 }
 
+/// A table of one row per item of `rows`, built column by column (a name and what to take from
+/// a row), then written by [`write_table`]: the stages that tabulate their points (the stability
+/// maps) say which columns they want, not how to collect them.
+pub struct RowTable<'a, R> {
+    rows: &'a [R],
+    cols: Vec<(&'static str, Owned)>,
+}
+
+/// A collected column of a [`RowTable`].
+enum Owned {
+    U64(Vec<u64>),
+    F64(Vec<f64>),
+    Str(Vec<String>),
+}
+
+impl<'a, R> RowTable<'a, R> {
+    pub fn new(rows: &'a [R]) -> Self {
+        Self {
+            rows,
+            cols: Vec::new(),
+        }
+    }
+    pub fn f64(mut self, name: &'static str, f: impl Fn(&R) -> f64) -> Self {
+        self.cols
+            .push((name, Owned::F64(self.rows.iter().map(f).collect())));
+        self
+    }
+    pub fn u64(mut self, name: &'static str, f: impl Fn(&R) -> u64) -> Self {
+        self.cols
+            .push((name, Owned::U64(self.rows.iter().map(f).collect())));
+        self
+    }
+    pub fn str<S: ToString>(mut self, name: &'static str, f: impl Fn(&R) -> S) -> Self {
+        let v = self.rows.iter().map(|r| f(r).to_string()).collect();
+        self.cols.push((name, Owned::Str(v)));
+        self
+    }
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let cols: Vec<(&str, Col)> = self
+            .cols
+            .iter()
+            .map(|(n, c)| {
+                let col = match c {
+                    Owned::U64(v) => Col::U64(v),
+                    Owned::F64(v) => Col::F64(v),
+                    Owned::Str(v) => Col::Str(v),
+                };
+                (*n, col)
+            })
+            .collect();
+        write_table(path, &cols)
+    }
+}
+
 /// Read a CSV table written by [`write_table`] (or any CSV with a header row).
 pub fn read_table(path: &Path) -> Result<DataFrame> {
     CsvReadOptions::default()

@@ -12,7 +12,7 @@
 use super::lbm::Operator;
 use super::{Class, Grid, Verdict, operator_maps};
 use crate::contract::{Stage, StageContext, StageOutput, Table};
-use crate::report::table::{Col, write_table};
+use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_lbm::D2Q9;
 use lbdem_lbm::cases::bingham_poiseuille::{Case, errors, run_channel};
@@ -289,27 +289,18 @@ impl Stage for BinghamMap {
 }
 
 fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
-    let s = |f: &dyn Fn(&Point) -> &'static str| points.iter().map(|q| f(q).to_string()).collect::<Vec<_>>();
-    let f = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<_>>();
-    let steps: Vec<u64> = points.iter().map(|q| q.steps).collect();
-    write_table(
-        path,
-        &[
-            ("operator", Col::Str(&s(&|q| q.operator.name()))),
-            ("tau_max", Col::F64(&f(&|q| q.tau_max))),
-            ("plug", Col::F64(&f(&|q| q.plug))),
-            ("verdict", Col::Str(&s(&|q| q.verdict.name()))),
-            ("class", Col::Str(&s(&|q| q.class.name()))),
-            ("l2", Col::F64(&f(&|q| q.l2))),
-            ("l2_clamped", Col::F64(&f(&|q| q.l2_clamped))),
-            ("plug_error", Col::F64(&f(&|q| q.plug_error))),
-            (
-                "converged",
-                Col::Str(&s(&|q| if q.converged { "yes" } else { "no" })),
-            ),
-            ("steps", Col::U64(&steps)),
-        ],
-    )
+    RowTable::new(points)
+        .str("operator", |q| q.operator.name())
+        .f64("tau_max", |q| q.tau_max)
+        .f64("plug", |q| q.plug)
+        .str("verdict", |q| q.verdict.name())
+        .str("class", |q| q.class.name())
+        .f64("l2", |q| q.l2)
+        .f64("l2_clamped", |q| q.l2_clamped)
+        .f64("plug_error", |q| q.plug_error)
+        .str("converged", |q| if q.converged { "yes" } else { "no" })
+        .u64("steps", |q| q.steps)
+        .write(path)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use super::bingham::verdict;
 use super::lbm::Operator;
 use super::{Class, Grid, Verdict, operator_maps};
 use crate::contract::{Stage, StageContext, StageOutput, Table};
-use crate::report::table::{Col, write_table};
+use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_lbm::D2Q9;
 use lbdem_lbm::cases::bingham_poiseuille::{Case, errors, run_channel};
@@ -268,26 +268,17 @@ impl Stage for BinghamFloorMap {
 }
 
 fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
-    let s = |f: &dyn Fn(&Point) -> &'static str| points.iter().map(|q| f(q).to_string()).collect::<Vec<_>>();
-    let f = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<_>>();
-    let steps: Vec<u64> = points.iter().map(|q| q.steps).collect();
-    write_table(
-        path,
-        &[
-            ("operator", Col::Str(&s(&|q| q.operator.name()))),
-            ("tau_min", Col::F64(&f(&|q| q.tau_min))),
-            ("tau_pl", Col::F64(&f(&|q| q.tau_pl))),
-            ("verdict", Col::Str(&s(&|q| q.verdict.name()))),
-            ("class", Col::Str(&s(&|q| q.class.name()))),
-            ("l2", Col::F64(&f(&|q| q.l2))),
-            ("l2_clamped", Col::F64(&f(&|q| q.l2_clamped))),
-            (
-                "converged",
-                Col::Str(&s(&|q| if q.converged { "yes" } else { "no" })),
-            ),
-            ("steps", Col::U64(&steps)),
-        ],
-    )
+    RowTable::new(points)
+        .str("operator", |q| q.operator.name())
+        .f64("tau_min", |q| q.tau_min)
+        .f64("tau_pl", |q| q.tau_pl)
+        .str("verdict", |q| q.verdict.name())
+        .str("class", |q| q.class.name())
+        .f64("l2", |q| q.l2)
+        .f64("l2_clamped", |q| q.l2_clamped)
+        .str("converged", |q| if q.converged { "yes" } else { "no" })
+        .u64("steps", |q| q.steps)
+        .write(path)
 }
 
 #[cfg(test)]

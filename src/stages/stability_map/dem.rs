@@ -9,7 +9,7 @@
 
 use super::{Class, Verdict, draw_map};
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
-use crate::report::table::{Col, write_table};
+use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_core::units::dem::ACCEPTED_FRACTION;
 use lbdem_dem::cases::{head_on, packing};
@@ -267,23 +267,17 @@ impl Stage for DemStepMap {
             );
         }
         let points = map(&p.laws, &p.ratios, p.speed, p.accuracy)?;
-        let s = |f: &dyn Fn(&Point) -> String| points.iter().map(f).collect::<Vec<_>>();
-        let f = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<_>>();
-        let steps: Vec<u64> = points.iter().map(|q| q.steps).collect();
-        write_table(
-            &ctx.out_dir.join("dem_step_map.csv"),
-            &[
-                ("law", Col::Str(&s(&|q| q.law.clone()))),
-                ("dt_over_critical", Col::F64(&f(&|q| q.ratio))),
-                ("verdict", Col::Str(&s(&|q| q.verdict.name().into()))),
-                ("class", Col::Str(&s(&|q| q.class.name().into()))),
-                ("restitution", Col::F64(&f(&|q| q.restitution))),
-                ("reference", Col::F64(&f(&|q| q.reference))),
-                ("max_overlap", Col::F64(&f(&|q| q.max_overlap))),
-                ("energy_error", Col::F64(&f(&|q| q.energy_error))),
-                ("steps", Col::U64(&steps)),
-            ],
-        )?;
+        RowTable::new(&points)
+            .str("law", |q| q.law.clone())
+            .f64("dt_over_critical", |q| q.ratio)
+            .str("verdict", |q| q.verdict.name())
+            .str("class", |q| q.class.name())
+            .f64("restitution", |q| q.restitution)
+            .f64("reference", |q| q.reference)
+            .f64("max_overlap", |q| q.max_overlap)
+            .f64("energy_error", |q| q.energy_error)
+            .u64("steps", |q| q.steps)
+            .write(&ctx.out_dir.join("dem_step_map.csv"))?;
         let mut names: Vec<String> = p.laws.iter().map(|l| l.name().to_string()).collect();
         names.push(PACKING.into());
         names.push(PACKING_HERTZ.into());

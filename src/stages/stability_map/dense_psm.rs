@@ -11,7 +11,7 @@
 
 use super::{Class, Grid, MapKey, Verdict, operator_maps};
 use crate::contract::{Stage, StageContext, StageOutput, Table};
-use crate::report::table::{Col, write_table};
+use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_coupling::CouplingError;
 use lbdem_coupling::cases::resolution::{Steady, disk_array, gebart_square, offsets, sangani_acrivos};
@@ -276,27 +276,20 @@ impl Stage for DensePsmMap {
 }
 
 fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
-    let s = |f: &dyn Fn(&Point) -> &'static str| points.iter().map(|q| f(q).to_string()).collect::<Vec<_>>();
-    let f = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<_>>();
-    let steps: Vec<u64> = points.iter().map(|q| q.steps).collect();
-    let nodes: Vec<u64> = points.iter().map(|q| q.nodes as u64).collect();
-    write_table(
-        path,
-        &[
-            ("cells_per_diameter", Col::F64(&f(&|q| q.cells_per_diameter))),
-            ("phi", Col::F64(&f(&|q| q.phi))),
-            ("tau", Col::F64(&f(&|q| q.tau))),
-            ("verdict", Col::Str(&s(&|q| q.verdict.name()))),
-            ("class", Col::Str(&s(&|q| q.class.name()))),
-            ("drag", Col::F64(&f(&|q| q.drag))),
-            ("drag_min", Col::F64(&f(&|q| q.drag_min))),
-            ("drag_max", Col::F64(&f(&|q| q.drag_max))),
-            ("reference", Col::F64(&f(&|q| q.reference))),
-            ("error", Col::F64(&f(&|q| q.error))),
-            ("nodes", Col::U64(&nodes)),
-            ("steps", Col::U64(&steps)),
-        ],
-    )
+    RowTable::new(points)
+        .f64("cells_per_diameter", |q| q.cells_per_diameter)
+        .f64("phi", |q| q.phi)
+        .f64("tau", |q| q.tau)
+        .str("verdict", |q| q.verdict.name())
+        .str("class", |q| q.class.name())
+        .f64("drag", |q| q.drag)
+        .f64("drag_min", |q| q.drag_min)
+        .f64("drag_max", |q| q.drag_max)
+        .f64("reference", |q| q.reference)
+        .f64("error", |q| q.error)
+        .u64("nodes", |q| q.nodes as u64)
+        .u64("steps", |q| q.steps)
+        .write(path)
 }
 
 #[cfg(test)]

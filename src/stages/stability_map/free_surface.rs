@@ -11,7 +11,7 @@
 use super::lbm::Operator;
 use super::{Class, Grid, Verdict, operator_maps};
 use crate::contract::{Stage, StageContext, StageOutput, Table};
-use crate::report::table::{Col, write_table};
+use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_core::units::lattice::CS2;
 use lbdem_lbm::free_surface::cases::{dam_break_fronts, dam_break_verdict};
@@ -233,26 +233,19 @@ impl Stage for FreeSurfaceMap {
 }
 
 fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
-    let s = |f: &dyn Fn(&Point) -> &'static str| points.iter().map(|q| f(q).to_string()).collect::<Vec<_>>();
-    let f = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<_>>();
-    let steps: Vec<u64> = points.iter().map(|q| q.steps).collect();
-    let conversions: Vec<u64> = points.iter().map(|q| q.conversions as u64).collect();
-    write_table(
-        path,
-        &[
-            ("operator", Col::Str(&s(&|q| q.operator.name()))),
-            ("tau", Col::F64(&f(&|q| q.tau))),
-            ("mach", Col::F64(&f(&|q| q.mach))),
-            ("gravity", Col::F64(&f(&|q| q.gravity))),
-            ("reynolds", Col::F64(&f(&|q| q.reynolds))),
-            ("verdict", Col::Str(&s(&|q| q.verdict.name()))),
-            ("class", Col::Str(&s(&|q| q.class.name()))),
-            ("front_error", Col::F64(&f(&|q| q.front_error))),
-            ("mass_drift", Col::F64(&f(&|q| q.mass_drift))),
-            ("conversions", Col::U64(&conversions)),
-            ("steps", Col::U64(&steps)),
-        ],
-    )
+    RowTable::new(points)
+        .str("operator", |q| q.operator.name())
+        .f64("tau", |q| q.tau)
+        .f64("mach", |q| q.mach)
+        .f64("gravity", |q| q.gravity)
+        .f64("reynolds", |q| q.reynolds)
+        .str("verdict", |q| q.verdict.name())
+        .str("class", |q| q.class.name())
+        .f64("front_error", |q| q.front_error)
+        .f64("mass_drift", |q| q.mass_drift)
+        .u64("conversions", |q| q.conversions as u64)
+        .u64("steps", |q| q.steps)
+        .write(path)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 
 use super::{Class, Grid, Verdict, operator_maps};
 use crate::contract::{Stage, StageContext, StageOutput, Table};
-use crate::report::table::{Col, write_table};
+use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_core::units::coupled::{PSM_DENSITY_RATIO_MIN, PSM_DENSITY_RATIO_WARN};
 use lbdem_coupling::cases::settling::{self, SettlingSpec};
@@ -280,21 +280,15 @@ impl Stage for InteriorLiquidMap {
 }
 
 fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
-    let s = |f: &dyn Fn(&Point) -> &'static str| points.iter().map(|q| f(q).to_string()).collect::<Vec<_>>();
-    let f = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<_>>();
-    let steps: Vec<u64> = points.iter().map(|q| q.steps).collect();
-    write_table(
-        path,
-        &[
-            ("correction", Col::Str(&s(&|q| q.correction.name()))),
-            ("ratio", Col::F64(&f(&|q| q.ratio))),
-            ("tau", Col::F64(&f(&|q| q.tau))),
-            ("verdict", Col::Str(&s(&|q| q.verdict.name()))),
-            ("class", Col::Str(&s(&|q| q.class.name()))),
-            ("error", Col::F64(&f(&|q| q.error))),
-            ("steps", Col::U64(&steps)),
-        ],
-    )
+    RowTable::new(points)
+        .str("correction", |q| q.correction.name())
+        .f64("ratio", |q| q.ratio)
+        .f64("tau", |q| q.tau)
+        .str("verdict", |q| q.verdict.name())
+        .str("class", |q| q.class.name())
+        .f64("error", |q| q.error)
+        .u64("steps", |q| q.steps)
+        .write(path)
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@ pub mod lbm;
 
 use crate::contract::{Figure, Stage, StageContext, StageOutput, Table};
 use crate::report::grid_map::{Cell, GridMap, Mark, grid_map_png};
-use crate::report::table::{Col, write_table};
+use crate::report::table::RowTable;
 use anyhow::{Result, bail};
 use lbdem_core::units::lattice::{CS2, U_MAX};
 use lbdem_lbm::cases;
@@ -222,21 +222,15 @@ impl Stage for StabilityMap {
 }
 
 fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
-    let s = |f: &dyn Fn(&Point) -> &'static str| points.iter().map(|q| f(q).to_string()).collect::<Vec<_>>();
-    let f = |f: &dyn Fn(&Point) -> f64| points.iter().map(f).collect::<Vec<_>>();
-    let steps: Vec<u64> = points.iter().map(|q| q.steps).collect();
-    write_table(
-        path,
-        &[
-            ("operator", Col::Str(&s(&|q| q.operator.name()))),
-            ("tau", Col::F64(&f(&|q| q.tau))),
-            ("mach", Col::F64(&f(&|q| q.mach))),
-            ("verdict", Col::Str(&s(&|q| q.verdict.name()))),
-            ("class", Col::Str(&s(&|q| q.class.name()))),
-            ("nu_error", Col::F64(&f(&|q| q.nu_error))),
-            ("steps", Col::U64(&steps)),
-        ],
-    )
+    RowTable::new(points)
+        .str("operator", |q| q.operator.name())
+        .f64("tau", |q| q.tau)
+        .f64("mach", |q| q.mach)
+        .str("verdict", |q| q.verdict.name())
+        .str("class", |q| q.class.name())
+        .f64("nu_error", |q| q.nu_error)
+        .u64("steps", |q| q.steps)
+        .write(path)
 }
 
 /// The axes of a per-operator map: the grid's values along x and y, and their labels.
