@@ -10,8 +10,8 @@
 //! exact profile of the clamped law), which shows what part of the error is the clamp's.
 
 use super::lbm::Operator;
-use super::{Class, Grid, Verdict, operator_maps};
-use crate::contract::{Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, Verdict, map_output, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput};
 use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_lbm::D2Q9;
@@ -246,7 +246,7 @@ impl Stage for BinghamMap {
             x_label: "upper clamp tau_max",
             y_label: "plug half-width y0/h",
         };
-        let (figures, mut files) = operator_maps(
+        let (figures, files) = operator_maps(
             &ctx.out_dir,
             "bingham_map",
             &p.operators,
@@ -269,22 +269,15 @@ impl Stage for BinghamMap {
                 )
             },
         )?;
-        files.insert(0, csv.into());
-        let disagree = points
-            .iter()
-            .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)
-            .count();
-        Ok(StageOutput {
-            summary: serde_json::json!({ "points": points, "accepted_but_blown_up": disagree }),
+        Ok(map_output(
+            csv,
+            "Every run of the Bingham map: verdict, class, L2 error against the Bingham and the clamped \
+                          profiles, plug error, steps",
+            &points,
+            |q| (q.verdict, q.class),
             figures,
-            tables: vec![Table {
-                path: csv.into(),
-                caption: "Every run of the Bingham map: verdict, class, L2 error against the Bingham and the clamped \
-                          profiles, plug error, steps"
-                    .into(),
-            }],
             files,
-        })
+        ))
     }
 }
 

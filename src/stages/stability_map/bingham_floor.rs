@@ -9,8 +9,8 @@
 
 use super::bingham::verdict;
 use super::lbm::Operator;
-use super::{Class, Grid, Verdict, operator_maps};
-use crate::contract::{Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, Verdict, map_output, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput};
 use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_lbm::D2Q9;
@@ -220,7 +220,7 @@ impl Stage for BinghamFloorMap {
             x_label: "lower clamp tau_min",
             y_label: "plastic relaxation time tau_pl",
         };
-        let (figures, mut files) = operator_maps(
+        let (figures, files) = operator_maps(
             &ctx.out_dir,
             "bingham_floor_map",
             &p.operators,
@@ -248,22 +248,15 @@ impl Stage for BinghamFloorMap {
                 )
             },
         )?;
-        files.insert(0, csv.into());
-        let disagree = points
-            .iter()
-            .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)
-            .count();
-        Ok(StageOutput {
-            summary: serde_json::json!({ "points": points, "accepted_but_blown_up": disagree }),
+        Ok(map_output(
+            csv,
+            "Every run of the Bingham floor map: verdict, class, L2 error against the Bingham and the \
+                          clamped profiles, steps",
+            &points,
+            |q| (q.verdict, q.class),
             figures,
-            tables: vec![Table {
-                path: csv.into(),
-                caption: "Every run of the Bingham floor map: verdict, class, L2 error against the Bingham and the \
-                          clamped profiles, steps"
-                    .into(),
-            }],
             files,
-        })
+        ))
     }
 }
 

@@ -9,8 +9,8 @@
 //! 0.785), where the gaps between the disks shrink below a cell. A coupled scene has no check
 //! on its packing, so every point is accepted; a blown-up point would be a disagreement.
 
-use super::{Class, Grid, MapKey, Verdict, operator_maps};
-use crate::contract::{Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, MapKey, Verdict, map_output, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput};
 use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_coupling::CouplingError;
@@ -233,7 +233,7 @@ impl Stage for DensePsmMap {
             y_label: "relaxation time tau",
         };
         let keys: Vec<Resolution> = p.cells_per_diameter.iter().map(|&n| Resolution(n)).collect();
-        let (figures, mut files) = operator_maps(
+        let (figures, files) = operator_maps(
             &ctx.out_dir,
             "dense_psm_map",
             &keys,
@@ -258,20 +258,15 @@ impl Stage for DensePsmMap {
                 )
             },
         )?;
-        files.insert(0, csv.into());
-        let disagree = points.iter().filter(|q| q.class == Class::BlownUp).count();
-        Ok(StageOutput {
-            summary: serde_json::json!({ "points": points, "accepted_but_blown_up": disagree }),
+        Ok(map_output(
+            csv,
+            "Every point of the dense PSM map: cells per diameter, solid fraction, tau, class, mean \
+                          drag and its range over the offsets, reference, error, nodes, steps",
+            &points,
+            |q| (q.verdict, q.class),
             figures,
-            tables: vec![Table {
-                path: csv.into(),
-                caption:
-                    "Every point of the dense PSM map: cells per diameter, solid fraction, tau, class, mean \
-                          drag and its range over the offsets, reference, error, nodes, steps"
-                        .into(),
-            }],
             files,
-        })
+        ))
     }
 }
 

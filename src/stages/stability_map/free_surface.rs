@@ -9,8 +9,8 @@
 //! (`LatticeUnits::derive`, u_max = Ritter's speed) is asked what it says of the same setting.
 
 use super::lbm::Operator;
-use super::{Class, Grid, Verdict, operator_maps};
-use crate::contract::{Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, Verdict, map_output, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput};
 use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_core::units::lattice::CS2;
@@ -190,7 +190,7 @@ impl Stage for FreeSurfaceMap {
             x_label: "Mach number of Ritter's front speed 2 sqrt(2 g a) / c_s",
             y_label: "relaxation time tau",
         };
-        let (figures, mut files) = operator_maps(
+        let (figures, files) = operator_maps(
             &ctx.out_dir,
             "free_surface_map",
             &p.operators,
@@ -212,23 +212,15 @@ impl Stage for FreeSurfaceMap {
                 )
             },
         )?;
-        files.insert(0, csv.into());
-        let disagree = points
-            .iter()
-            .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)
-            .count();
-        Ok(StageOutput {
-            summary: serde_json::json!({ "points": points, "accepted_but_blown_up": disagree }),
+        Ok(map_output(
+            csv,
+            "Every run of the free-surface map: set-up verdict, class, front error, mass drift, \
+                          conversions, steps",
+            &points,
+            |q| (q.verdict, q.class),
             figures,
-            tables: vec![Table {
-                path: csv.into(),
-                caption:
-                    "Every run of the free-surface map: set-up verdict, class, front error, mass drift, \
-                          conversions, steps"
-                        .into(),
-            }],
             files,
-        })
+        ))
     }
 }
 

@@ -9,8 +9,8 @@
 //! inaccurate, or blown up (stopped by the engine's limits). What the run-time checks of a coupled
 //! scene say of the same grain ([`verdict`]) is recorded beside each point.
 
-use super::{Class, Grid, Verdict, operator_maps};
-use crate::contract::{Stage, StageContext, StageOutput, Table};
+use super::{Class, Grid, Verdict, map_output, operator_maps};
+use crate::contract::{Stage, StageContext, StageOutput};
 use crate::report::table::RowTable;
 use anyhow::{Result, anyhow, bail};
 use lbdem_core::units::coupled::{PSM_DENSITY_RATIO_MIN, PSM_DENSITY_RATIO_WARN};
@@ -237,7 +237,7 @@ impl Stage for InteriorLiquidMap {
             x_label: "grain / liquid density ratio rho_S / rho_L",
             y_label: "relaxation time tau",
         };
-        let (figures, mut files) = operator_maps(
+        let (figures, files) = operator_maps(
             &ctx.out_dir,
             "interior_liquid_map",
             &[Correction::Off, Correction::On],
@@ -260,22 +260,15 @@ impl Stage for InteriorLiquidMap {
                 )
             },
         )?;
-        files.insert(0, csv.into());
-        let disagree = points
-            .iter()
-            .filter(|q| q.verdict == Verdict::Accepted && q.class == Class::BlownUp)
-            .count();
-        Ok(StageOutput {
-            summary: serde_json::json!({ "points": points, "accepted_but_blown_up": disagree }),
+        Ok(map_output(
+            csv,
+            "Every run of the interior-liquid map: correction, density ratio, tau, run-time \
+                          verdict, class, terminal-velocity error, steps",
+            &points,
+            |q| (q.verdict, q.class),
             figures,
-            tables: vec![Table {
-                path: csv.into(),
-                caption: "Every run of the interior-liquid map: correction, density ratio, tau, run-time \
-                          verdict, class, terminal-velocity error, steps"
-                    .into(),
-            }],
             files,
-        })
+        ))
     }
 }
 

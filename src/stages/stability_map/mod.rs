@@ -233,6 +233,33 @@ fn write_points(path: &std::path::Path, points: &[Point]) -> Result<()> {
         .write(path)
 }
 
+/// What a map stage returns: its table (first among the files) and its figures, and in the
+/// summary every point with the count of runs the checks accepted that blew up, where a map and
+/// the checks disagree.
+fn map_output<P: Serialize>(
+    csv: &str,
+    caption: &str,
+    points: &[P],
+    judged: impl Fn(&P) -> (Verdict, Class),
+    figures: Vec<Figure>,
+    mut files: Vec<PathBuf>,
+) -> StageOutput {
+    files.insert(0, csv.into());
+    let disagree = points
+        .iter()
+        .filter(|q| judged(q) == (Verdict::Accepted, Class::BlownUp))
+        .count();
+    StageOutput {
+        summary: serde_json::json!({ "points": points, "accepted_but_blown_up": disagree }),
+        figures,
+        tables: vec![Table {
+            path: csv.into(),
+            caption: caption.into(),
+        }],
+        files,
+    }
+}
+
 /// The axes of a per-operator map: the grid's values along x and y, and their labels.
 struct Grid<'a> {
     xs: &'a [f64],
