@@ -6,23 +6,25 @@
 //! `ForceTorque`). The solid-fraction map of `solid_fraction` (circle ∩ square cells) stays 2D:
 //! a 3D run brings its own `SolidMap` (cell index = node index x + nx (y + ny z)).
 //!
-//! Storage is array-of-structures (`f[node * 9 + i]`) so that rows of nodes are contiguous and
-//! can be handed to rayon tasks as plain slices; coupled grids are small (Su et al.: about
-//! 250 x 190 nodes) and the step is dominated by the DEM sub-cycles, so clarity wins here over
-//! the structure-of-arrays kernels of `lbdem-lbm`. Populations are stored in `T` (f64 or f32)
-//! and every update is computed in f64. The liquid part of the collision is the operator of
+//! Storage is direction-major (`f[i * nodes + node]`, the structure of arrays of `lbdem-lbm`):
+//! the lanes of a block of consecutive nodes load and store each population as one vector
+//! (node-major storage made every block a gather and a scatter of stride Q; the lattice step
+//! alone takes 0.6 of the time since, docs/performance.md). Checkpoints keep the
+//! node-major order ([`PsmState::f`]). Populations are stored in `T` (f64 or f32) and every
+//! update is computed in f64. The liquid part of the collision is the operator of
 //! `lbdem-lbm` (`lbdem_lbm::Collider`: BGK or TRT, uniform or with per-node τ), so the choice of
 //! collision is made in one place for every lattice.
 //!
-//! Determinism: rows are split into fixed chunks; each chunk writes its own slice of the
-//! population array and of the per-cover force buffer, and the per-grain sums run serially in
-//! cover order, so the result is bitwise the same for any number of threads.
+//! Determinism: rows are split into fixed chunks; each chunk writes only its own nodes of the
+//! population array and its own slice of the per-cover force buffer, and the per-grain sums run
+//! serially in cover order, so the result is bitwise the same for any number of threads.
 
 use crate::error::CouplingError;
 use crate::solid_fraction::{CellCover, SolidMap};
 use crate::weighting::psm_weight;
 use lbdem_core::simd::{self, Simd, WithSimd};
 use lbdem_lbm::collision::{CollideParams, Collider, LocalRates, NodeRates, local_rates};
+use lbdem_lbm::kernel::{LimitsT, SyncPtr};
 use lbdem_lbm::lattice::QMAX;
 use lbdem_lbm::plan::{Upstream, neighbour};
 use lbdem_lbm::{
@@ -82,8 +84,8 @@ pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
     pub ny: usize,
     /// 1 in 2D.
     pub nz: usize,
-    /// Post-collision populations of the current time, `f[node * Q + i]`.
-    pub f: Vec<T>,
+    /// Post-collision populations of the current time, `f[i * nodes + node]`.
+    f: Vec<T>,
     other: Vec<T>,
     /// Pull source of population i at node x: index of the upstream node, or `WALL | w`.
     src: Vec<u32>,
@@ -133,6 +135,7 @@ pub struct PsmFluid<T: Real, L: Lattice = D2Q9> {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(bound = "")]
 pub struct PsmState<T: Real> {
+    /// Node-major, `f[node * Q + i]` (the lattice itself is direction-major).
     pub f: Vec<T>,
     pub rho: Vec<f64>,
     pub u: Vec<[f64; 3]>,
@@ -261,12 +264,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
                 src[idx * q + i] = link::<L>(domain, &active, &active, &zone, zone_base, idx, i);
             }
         }
-        let mut f = vec![T::default(); n * q];
-        for node in f.chunks_exact_mut(q) {
-            for i in 0..q {
-                node[i] = T::from_f64(L::W[i]);
-            }
-        }
+        let f: Vec<T> = (0..n * q).map(|k| T::from_f64(L::W[k / n])).collect();
         Ok(Self {
             nx,
             ny,
@@ -345,8 +343,9 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
 
     /// The state to checkpoint (see [`PsmState`]).
     pub fn state(&self) -> PsmState<T> {
+        let (n, q) = (self.nodes(), L::Q);
         PsmState {
-            f: self.f.clone(),
+            f: (0..n * q).map(|k| self.f[(k % q) * n + k / q]).collect(),
             rho: self.rho.clone(),
             u: self.u.clone(),
             local_tau: self.local.as_ref().map(|(_, t)| t.clone()),
@@ -385,7 +384,8 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
                 state.zone.len()
             )));
         }
-        self.f = state.f;
+        let q = L::Q;
+        self.f = (0..n * q).map(|k| state.f[(k % n) * q + k / n]).collect();
         self.rho = state.rho;
         self.u = state.u;
         self.step = state.step;
@@ -460,7 +460,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             }
             changed.push(idx);
             if self.zone[idx] == LIQUID {
-                let m: f64 = self.f[idx * q..(idx + 1) * q].iter().map(|v| v.to_f64()).sum();
+                let m: f64 = (0..q).map(|i| self.f[i * n + idx].to_f64()).sum();
                 self.zone_mass.removed += m;
                 self.zone_mass.closed += 1;
                 self.active[idx] = false;
@@ -486,7 +486,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             let u = covered_by[from as usize];
             let usq = norm2::<L>(u);
             for i in 0..q {
-                self.f[idx * q + i] = T::from_f64(feq::<L>(i, rho, u, usq));
+                self.f[i * n + idx] = T::from_f64(feq::<L>(i, rho, u, usq));
             }
             self.rho[idx] = rho;
             self.u[idx] = u;
@@ -590,7 +590,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             let co = L::C[o];
             let cu = c[0] as f64 * uw[0] + c[1] as f64 * uw[1] + c[2] as f64 * uw[2];
             let inject = 6.0 * L::W[i] * cu;
-            let fo = self.f[x * q + o].to_f64();
+            let fo = self.f[o * self.nodes() + x].to_f64();
             for a in 0..3 {
                 e.pull[a] += 2.0 * fo * co[a] as f64;
                 e.wall[a] += inject * co[a] as f64;
@@ -608,14 +608,14 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
 
     /// Total mass and momentum of the populations of the active nodes (lattice units).
     pub fn mass_momentum3(&self) -> (f64, [f64; 3]) {
-        let q = L::Q;
+        let (q, n) = (L::Q, self.nodes());
         let (mut m, mut j) = (0.0, [0.0; 3]);
-        for (node, a) in self.f.chunks_exact(q).zip(&self.active) {
+        for (idx, a) in self.active.iter().enumerate() {
             if !a {
                 continue;
             }
             for i in 0..q {
-                let v = node[i].to_f64();
+                let v = self.f[i * n + idx].to_f64();
                 m += v;
                 j[0] += v * L::C[i][0] as f64;
                 j[1] += v * L::C[i][1] as f64;
@@ -648,7 +648,6 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             (map.nx, map.ny) == (nx, ny) && map.total.len() == n,
             "solid map and lattice differ in size"
         );
-        let q = L::Q;
         // Covers of cell c are covers[start[c]..start[c + 1]] (the map is sorted by cell).
         // One pass over the covers: each cell's first cover is where the cell index first
         // reaches it.
@@ -673,6 +672,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             nx,
             ny,
             nz,
+            n,
             f_in: &self.f,
             src: &self.src,
             regular: &self.regular,
@@ -683,7 +683,7 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
             grains,
             tau: self.settings.collision.tau(),
             local_tau: self.local.as_ref().map(|(_, t)| t.as_slice()),
-            limits,
+            limits: limits.in_precision::<f64>(),
             scale: self.pull_scale,
         };
 
@@ -691,26 +691,24 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
         let rows_chunk = ROWS_PER_TASK * nx;
         let mut tasks = Vec::with_capacity(ny.div_ceil(ROWS_PER_TASK));
         {
-            let mut f_out: &mut [T] = &mut self.other;
+            let f_out = SyncPtr(self.other.as_mut_ptr());
             let mut rho: &mut [f64] = &mut self.rho;
             let mut u: &mut [[f64; 3]] = &mut self.u;
             let mut loads_rest: &mut [ForceTorque] = &mut self.cover_load;
             let mut node0 = 0;
             while node0 < n {
                 let len = rows_chunk.min(n - node0);
-                let (fa, fb) = std::mem::take(&mut f_out).split_at_mut(len * q);
                 let (ra, rb) = std::mem::take(&mut rho).split_at_mut(len);
                 let (ua, ub) = std::mem::take(&mut u).split_at_mut(len);
                 let nc = (start[node0 + len] - start[node0]) as usize;
                 let (la, lb) = std::mem::take(&mut loads_rest).split_at_mut(nc);
                 tasks.push(Chunk {
                     node0,
-                    f_out: fa,
+                    f_out,
                     rho: ra,
                     u: ua,
                     loads: la,
                 });
-                f_out = fb;
                 rho = rb;
                 u = ub;
                 loads_rest = lb;
@@ -775,13 +773,13 @@ impl<T: Real, L: Lattice> PsmFluid<T, L> {
 impl<T: Real> PsmFluid<T, D2Q9> {
     /// Set every node to the equilibrium of density `rho` and velocity `u(x, y)`.
     pub fn init_equilibrium(&mut self, init: impl Fn(usize, usize) -> (f64, [f64; 2])) {
-        let q = D2Q9::Q;
-        for idx in 0..self.nx * self.ny {
+        let (q, n) = (D2Q9::Q, self.nx * self.ny);
+        for idx in 0..n {
             let (rho, u) = init(idx % self.nx, idx / self.nx);
             let u = [u[0], u[1], 0.0];
             let usq = norm2::<D2Q9>(u);
             for i in 0..q {
-                self.f[idx * q + i] = T::from_f64(feq::<D2Q9>(i, rho, u, usq));
+                self.f[i * n + idx] = T::from_f64(feq::<D2Q9>(i, rho, u, usq));
             }
             self.rho[idx] = rho;
             self.u[idx] = u;
@@ -917,6 +915,8 @@ struct Base<'a, T> {
     nx: usize,
     ny: usize,
     nz: usize,
+    /// Nodes of the lattice: the stride between the planes of `f_in` and `Chunk::f_out`.
+    n: usize,
     f_in: &'a [T],
     src: &'a [u32],
     regular: &'a [bool],
@@ -927,7 +927,7 @@ struct Base<'a, T> {
     grains: &'a [Motion],
     tau: f64,
     local_tau: Option<&'a [f64]>,
-    limits: Limits,
+    limits: LimitsT<f64>,
     /// Factor on every pulled population (`PsmFluid::set_pull_scale`).
     scale: f64,
 }
@@ -935,7 +935,8 @@ struct Base<'a, T> {
 /// The nodes [node0, node0 + rho.len()) of one task and its share of the outputs.
 struct Chunk<'a, T> {
     node0: usize,
-    f_out: &'a mut [T],
+    /// The whole post-collision array (direction-major): the chunk writes its own nodes only.
+    f_out: SyncPtr<T>,
     rho: &'a mut [f64],
     u: &'a mut [[f64; 3]],
     loads: &'a mut [ForceTorque],
@@ -987,9 +988,10 @@ impl<T: Real, L: Lattice, C: Collider<L, f64>> WithSimd for ChunkOp<'_, T, L, C>
     }
 }
 
-/// Nodes collided side by side (as the lanes of `lbdem_lbm`'s collision): four f64 lanes fill
-/// an AVX2 register. Runs of fewer active nodes go one at a time through the same code.
-const LANES: usize = 4;
+/// Nodes collided side by side (as the lanes of `lbdem_lbm`'s collision): eight f64 lanes fill
+/// an AVX-512 register (two AVX2 ones). Runs of fewer active nodes go four or one at a time
+/// through the same code.
+const LANES: usize = 8;
 
 /// The first node outside the limits: (node, ρ, u).
 type Bad = Option<(usize, f64, [f64; 3])>;
@@ -1024,6 +1026,9 @@ fn chunk<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool>(
         if k + LANES <= len && b.active[idx..idx + LANES].iter().all(|&a| a) {
             nodes::<T, L, C, F, LANES>(b, coll, &cf, &mut out, k, &mut first_bad);
             k += LANES;
+        } else if k + 4 <= len && b.active[idx..idx + 4].iter().all(|&a| a) {
+            nodes::<T, L, C, F, 4>(b, coll, &cf, &mut out, k, &mut first_bad);
+            k += 4;
         } else {
             if b.active[idx] {
                 nodes::<T, L, C, F, 1>(b, coll, &cf, &mut out, k, &mut first_bad);
@@ -1065,16 +1070,25 @@ fn nodes<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool, const W: usize
     first_bad: &mut Bad,
 ) {
     let q = L::Q;
+    let n = b.n;
     let idx0 = out.node0 + k;
     let c0 = b.start[out.node0] as usize;
     // Pull-stream (Su Eq. 12), bounce-back from walls and inactive nodes (Leonardi Eq. 19).
     let mut f = [[0.0; W]; QMAX];
     if b.regular[idx0..idx0 + W].iter().all(|&r| r) {
-        // Every lane pulls from its upstream nodes: the same values `src` names.
+        // Every lane pulls from its upstream nodes: the same values `src` names, W consecutive
+        // values of plane i. A scale of 1 is left out (1 x is x: the same bits).
         for i in 0..q {
-            let up = idx0 as isize - pull_offset::<L>(i, [b.nx, b.ny, b.nz]);
-            for w in 0..W {
-                f[i][w] = b.scale * b.f_in[(up as usize + w) * q + i].to_f64();
+            let up = (i * n) as isize + idx0 as isize - pull_offset::<L>(i, [b.nx, b.ny, b.nz]);
+            let row = &b.f_in[up as usize..up as usize + W];
+            if b.scale == 1.0 {
+                for w in 0..W {
+                    f[i][w] = row[w].to_f64();
+                }
+            } else {
+                for w in 0..W {
+                    f[i][w] = b.scale * row[w].to_f64();
+                }
             }
         }
     } else {
@@ -1083,7 +1097,7 @@ fn nodes<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool, const W: usize
                 let idx = idx0 + w;
                 let s = b.src[idx * q + i];
                 f[i][w] = if s & WALL == 0 {
-                    b.scale * b.f_in[s as usize * q + i].to_f64()
+                    b.scale * b.f_in[i * n + s as usize].to_f64()
                 } else {
                     let uw = b.wall_u[(s & !WALL) as usize];
                     let c = cf[i];
@@ -1091,7 +1105,7 @@ fn nodes<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool, const W: usize
                     if L::D == 3 {
                         cu += c[2] * uw[2];
                     }
-                    b.scale * b.f_in[idx * q + L::OPP[i]].to_f64() + 6.0 * L::W[i] * cu
+                    b.scale * b.f_in[L::OPP[i] * n + idx].to_f64() + 6.0 * L::W[i] * cu
                 };
             }
         }
@@ -1224,18 +1238,19 @@ fn nodes<T: Real, L: Lattice, C: Collider<L, f64>, const F: bool, const W: usize
             }
         }
     }
+    for (i, p) in post.iter().enumerate().take(q) {
+        for w in 0..W {
+            // SAFETY: node idx0 + w belongs to this chunk (`Chunk::f_out`), plane i is in bounds.
+            unsafe { *out.f_out.0.add(i * n + idx0 + w) = T::from_f64(p[w]) };
+        }
+    }
+    let bad = b.limits.bad_lanes(&m.rho, &m.usq);
+    if bad != 0 && first_bad.is_none() {
+        let w = bad.trailing_zeros() as usize;
+        *first_bad = Some((idx0 + w, m.rho[w], [m.u[0][w], m.u[1][w], m.u[2][w]]));
+    }
     for w in 0..W {
-        let kk = k + w;
-        let dst = &mut out.f_out[kk * q..(kk + 1) * q];
-        for i in 0..q {
-            dst[i] = T::from_f64(post[i][w]);
-        }
-        let rho = m.rho[w];
-        let u = [m.u[0][w], m.u[1][w], m.u[2][w]];
-        if !b.limits.accepts(rho, u) && first_bad.is_none() {
-            *first_bad = Some((idx0 + w, rho, u));
-        }
-        out.rho[kk] = rho;
-        out.u[kk] = u;
+        out.rho[k + w] = m.rho[w];
+        out.u[k + w] = [m.u[0][w], m.u[1][w], m.u[2][w]];
     }
 }
