@@ -8,8 +8,9 @@ use anyhow::{Context, Result, bail};
 use lbdem_coupling::Method;
 use lbdem_coupling::cases::resolution::{Steady, disk_array, offsets, offsets_at, sangani_acrivos};
 use lbdem_coupling::cases::settling::{self, SettlingSpec};
-use lbdem_lbm::Collision;
 use lbdem_lbm::cases::poiseuille::poiseuille;
+use lbdem_lbm::cases::taylor_green::{self, StoredRun};
+use lbdem_lbm::{Collision, ShiftedF16, ShiftedF32};
 use std::path::Path;
 
 /// Lattice resolution: Stokes drag of a square array of disks at solid fraction `phi` against
@@ -86,6 +87,44 @@ pub fn coupling(resolutions: &[usize], duration: f64) -> Result<(Vec<Point>, Vec
         }
     }
     Ok((method, precision))
+}
+
+/// The populations' storage in the in-place AA kernel (`lbdem_lbm::storage`): f64 and f32 as
+/// themselves, f32s (f32 storage of f − w_i, f64 arithmetic) and f16s (binary16 storage of
+/// f − w_i, f32 arithmetic), on the decaying Taylor-Green vortex (`taylor_green::stored`) of
+/// each box side in `sizes` and each amplitude in `u0s`, `steps` steps, against the analytic
+/// field. One study per amplitude ([`storage_study`]: the two are different cases, each with its
+/// own front); `value` is the box side; the wall time is the stepping's.
+pub fn storage(sizes: &[usize], u0s: &[f64], steps: usize) -> Result<Vec<Point>> {
+    type Run = fn(usize, f64, usize) -> Result<StoredRun, lbdem_lbm::LbmError>;
+    let kinds: [(&str, Run); 4] = [
+        ("f64", taylor_green::stored::<f64, f64>),
+        ("f32", taylor_green::stored::<f32, f32>),
+        ("f32s", taylor_green::stored::<f64, ShiftedF32>),
+        ("f16s", taylor_green::stored::<f32, ShiftedF16>),
+    ];
+    let mut out = Vec::new();
+    for &u0 in u0s {
+        for (name, run) in kinds {
+            for &l in sizes {
+                let r = run(l, u0, steps)
+                    .with_context(|| format!("Taylor-Green vortex, {name} storage, {l} x {l}, u0 = {u0}"))?;
+                out.push(Point {
+                    study: storage_study(u0),
+                    setting: name.into(),
+                    value: l as f64,
+                    error: r.error,
+                    wall_seconds: r.seconds,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The storage study's name at vortex amplitude `u0`.
+pub fn storage_study(u0: f64) -> String {
+    format!("storage-u0-{u0:e}")
 }
 
 /// BGK against TRT: plane Poiseuille flow between halfway bounce-back walls ([`poiseuille`]),

@@ -33,6 +33,15 @@ pub struct Params {
     /// Channel heights (fluid rows) of the BGK-against-TRT study.
     #[serde(default = "heights")]
     pub heights: Vec<usize>,
+    /// Box sides of the storage study (the Taylor-Green vortex; [] leaves it out).
+    #[serde(default = "storage")]
+    pub storage: Vec<usize>,
+    /// Vortex amplitudes (lattice units) of the storage study: the smaller shows the stored form.
+    #[serde(default = "storage_u0")]
+    pub storage_u0: Vec<f64>,
+    /// Steps of each storage run.
+    #[serde(default = "storage_steps")]
+    pub storage_steps: usize,
     /// Knobs read from finished sweeps with replicas (mass scaling, the DEM step).
     #[serde(default)]
     pub sweeps: Vec<SweepStudy>,
@@ -80,6 +89,15 @@ fn taus() -> Vec<f64> {
 fn heights() -> Vec<usize> {
     vec![8, 16, 32]
 }
+fn storage() -> Vec<usize> {
+    vec![64, 256, 1024]
+}
+fn storage_u0() -> Vec<f64> {
+    vec![1e-2, 1e-4]
+}
+fn storage_steps() -> usize {
+    1000
+}
 
 /// A study's chart: file, title, error label, caption, log axes.
 struct Chart {
@@ -95,7 +113,7 @@ pub struct Tradeoffs;
 
 impl Stage for Tradeoffs {
     const KIND: &'static str = "tradeoffs";
-    const ABOUT: &'static str = "Speed against accuracy: a Pareto chart per knob (resolution, precision, method, collision, mass scaling)";
+    const ABOUT: &'static str = "Speed against accuracy: a Pareto chart per knob (resolution, precision, method, collision, storage, mass scaling)";
     type Params = Params;
 
     fn inputs(p: &Params, ctx: &StageContext) -> Vec<PathBuf> {
@@ -109,6 +127,7 @@ impl Stage for Tradeoffs {
             !p.resolution.is_empty(),
             !p.settling.is_empty(),
             !p.taus.is_empty(),
+            !p.storage.is_empty(),
         ];
         let bar = ctx.progress_bar(
             (work.iter().filter(|w| **w).count() + p.sweeps.len()) as u64,
@@ -177,6 +196,28 @@ impl Stage for Tradeoffs {
                 ),
                 log: true,
             });
+            bar.inc(1);
+        }
+        if work[3] {
+            points.extend(pool.install(|| studies::storage(&p.storage, &p.storage_u0, p.storage_steps))?);
+            for &u0 in &p.storage_u0 {
+                let study = studies::storage_study(u0);
+                charts.push(Chart {
+                    file: format!("tradeoff_{study}.png"),
+                    study,
+                    title: format!("storage: f64, f32, f32s, f16s populations, vortex u0 = {u0:e}"),
+                    error: "max |u - u_exact| / u_max".into(),
+                    caption: format!(
+                        "Population storage in the in-place AA kernel: f64 and f32 as themselves, f32s (f32 storage \
+                         of f - w_i, f64 arithmetic), f16s (binary16 storage of f - w_i, f32 arithmetic). The \
+                         decaying Taylor-Green vortex (BGK τ = 0.8) of amplitude u0 = {u0:e} on periodic boxes of \
+                         {:?} nodes a side, {} steps: the largest deviation of the velocity field from the analytic \
+                         one over its amplitude. x: wall time of the stepping.",
+                        p.storage, p.storage_steps
+                    ),
+                    log: true,
+                });
+            }
             bar.inc(1);
         }
         for s in &p.sweeps {
@@ -305,6 +346,29 @@ fn check(p: &Params) -> Result<()> {
             p.heights
         );
     }
+    if let Some(l) = p.storage.iter().find(|l| **l < 8) {
+        bail!(
+            "tradeoffs: storage = {:?} holds {l}; give box sides of at least 8 nodes, e.g. [64, 256, 1024]",
+            p.storage
+        );
+    }
+    if !p.storage.is_empty() {
+        if let Some(u) = p.storage_u0.iter().find(|u| !(**u > 0.0 && **u <= 0.1)) {
+            bail!(
+                "tradeoffs: storage_u0 = {:?} holds {u}; give vortex amplitudes in (0, 0.1] lattice units (Mach \
+                 below 0.17), e.g. [1e-2, 1e-4]",
+                p.storage_u0
+            );
+        }
+        if p.storage_u0.is_empty() || p.storage_steps == 0 {
+            bail!(
+                "tradeoffs: the storage study needs amplitudes (storage_u0 = {:?}) and steps (storage_steps = {}); \
+                 e.g. [1e-2, 1e-4] and 1000, or storage = [] to leave it out",
+                p.storage_u0,
+                p.storage_steps
+            );
+        }
+    }
     Ok(())
 }
 
@@ -340,6 +404,9 @@ mod tests {
             duration: 0.6,
             taus: vec![0.8, 1.5],
             heights: vec![8, 16],
+            storage: vec![64],
+            storage_u0: vec![1e-2, 1e-4],
+            storage_steps: 200,
             sweeps: Vec::new(),
             threads: 0,
         };
@@ -349,6 +416,8 @@ mod tests {
             "tradeoff_method.png",
             "tradeoff_precision.png",
             "tradeoff_collision.png",
+            "tradeoff_storage-u0-1e-2.png",
+            "tradeoff_storage-u0-1e-4.png",
             "tradeoffs.csv",
         ] {
             assert!(dir.path().join(f).is_file(), "{f}");
@@ -397,8 +466,31 @@ mod tests {
                 assert!(e < 1e-10, "{setting}, h {h}: {e}");
             }
         }
+        // Storage (Taylor-Green, 64 x 64, 200 steps; measured errors over the amplitude, u0 = 1e-2 and
+        // 1e-4: f64 1.1816e-3, 1.1403e-3; f32 1.1842e-3, 5.39e-3; f32s 1.1816e-3, 1.1403e-3; f16s
+        // 1.82e-3, 6.22e-3): f32s stays with f64 (measured within 3.8e-8), f32 stored as itself
+        // loses the slow vortex (4.7 times f32s's error), f16s within twice its error.
+        let e = |kind: &str, u0: &str| {
+            pts(&out, &format!("storage-u0-{u0}"))
+                .iter()
+                .find(|p| p["point"]["setting"] == kind)
+                .map(|p| num(p, "error"))
+                .unwrap()
+        };
+        for u0 in ["1e-2", "1e-4"] {
+            assert!((e("f32s", u0) - e("f64", u0)).abs() < 8e-8, "u0 {u0}");
+        }
+        assert!(e("f32", "1e-4") > 3.0 * e("f32s", "1e-4"));
+        assert!(e("f16s", "1e-2") < 3.7e-3 && e("f16s", "1e-4") < 1.3e-2);
         // The front: every study has one, and holds its most accurate setting.
-        for s in ["resolution", "method", "precision", "collision"] {
+        for s in [
+            "resolution",
+            "method",
+            "precision",
+            "collision",
+            "storage-u0-1e-2",
+            "storage-u0-1e-4",
+        ] {
             let v = pts(&out, s);
             let best = v
                 .iter()
@@ -420,10 +512,14 @@ mod tests {
         let e = Tradeoffs::run(&p, &ctx).unwrap_err().to_string();
         assert!(e.contains("taus") && e.contains("above 1/2"), "{e}");
         p = toml::from_str(
-            "resolution = []\nsettling = []\ntaus = []\n[[sweeps]]\nstudy = \"mass-scaling\"\nwhat = \"x\"\ndir = \"nowhere\"\naxis = \"mass_scale\"\nreference = 1.0",
+            "resolution = []\nsettling = []\ntaus = []\nstorage = []\n[[sweeps]]\nstudy = \"mass-scaling\"\nwhat = \"x\"\ndir = \"nowhere\"\naxis = \"mass_scale\"\nreference = 1.0",
         )
         .unwrap();
         let e = Tradeoffs::run(&p, &ctx).unwrap_err().to_string();
         assert!(e.contains("nowhere") && e.contains("lbdem sweep"), "{e}");
+        p = toml::from_str("resolution = []\nsettling = []\ntaus = []\nstorage = [64]\nstorage_u0 = [0.5]")
+            .unwrap();
+        let e = Tradeoffs::run(&p, &ctx).unwrap_err().to_string();
+        assert!(e.contains("storage_u0") && e.contains("(0, 0.1]"), "{e}");
     }
 }
