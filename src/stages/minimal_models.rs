@@ -30,7 +30,7 @@ pub struct Params {
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Study {
-    /// "shear-cell" or "float": which scenes the rows speak for ([`simplify::family`]).
+    /// "shear-cell", "float" or "extruder": which scenes the rows speak for ([`simplify::family`]).
     pub family: String,
     /// The case, in a few words (a column of the table).
     pub study: String,
@@ -67,7 +67,7 @@ fn none() -> String {
 }
 
 /// The families a table row may speak for.
-const FAMILIES: [&str; 2] = ["shear-cell", "float"];
+const FAMILIES: [&str; 3] = ["shear-cell", "float", "extruder"];
 
 /// One row: a simplification in a study, its change and its saving.
 struct Row<'a> {

@@ -20,6 +20,11 @@ pub const FIXED_YIELD_RATE: f64 = 30.0e-6;
 /// `keeping_the_solid_map_within_a_twentieth_of_a_cell_leaves_the_results_unchanged` checks.
 pub const REMAP_CELLS: f64 = 0.05;
 
+/// The lubrication cut `short-lubrication` sets (in d_ij): a fifth of Ness et al.'s 0.05 d_ij
+/// (Sect. "Lubrication"), ten times their h_min. Pairs between the two gaps exchange lubrication
+/// forces below a tenth of those at the smallest gap (Eq. 3 goes as 1/h).
+pub const SHORT_LUBRICATION: f64 = 0.01;
+
 /// One simplification: its name in scene files and tables, what it leaves out, and the edit.
 pub struct Simplification {
     pub name: &'static str,
@@ -58,6 +63,11 @@ pub const CATALOGUE: &[Simplification] = &[
         name: "remap",
         what: "a grain's solid fraction recomputed only once it moved 0.05 cells ([coupling] remap_tolerance = 0.05)",
         edit: remap,
+    },
+    Simplification {
+        name: "short-lubrication",
+        what: "lubrication only across gaps below 0.01 d_ij instead of Ness et al.'s 0.05 d_ij ([suspension] h_max = 0.01)",
+        edit: short_lubrication,
     },
     Simplification {
         name: "coarser-dem-step",
@@ -209,6 +219,22 @@ fn coarser_dem_step(t: &mut toml::Table) -> Result<(), String> {
     Ok(())
 }
 
+fn short_lubrication(t: &mut toml::Table) -> Result<(), String> {
+    let s = section(t, "suspension").ok_or("the scene has no lubricated suspension ([suspension])")?;
+    let h_max = s.get("h_max").and_then(Value::as_float).unwrap_or(0.05);
+    if h_max <= SHORT_LUBRICATION {
+        return Err(format!("[suspension] h_max is {h_max} already"));
+    }
+    let h_min = s.get("h_min").and_then(Value::as_float).unwrap_or(0.001);
+    if h_min >= SHORT_LUBRICATION {
+        return Err(format!(
+            "[suspension] h_min = {h_min} is not below the short cut {SHORT_LUBRICATION}"
+        ));
+    }
+    s.insert("h_max".into(), Value::Float(SHORT_LUBRICATION));
+    Ok(())
+}
+
 /// `simplify = "none"`, `"no-rolling+f32"` or `["no-rolling", "f32"]`: the names, checked.
 pub fn parse_list(v: &Value) -> Result<Vec<&'static Simplification>, String> {
     let raw: Vec<String> = match v {
@@ -237,6 +263,8 @@ pub fn family(t: &toml::Table) -> Option<&'static str> {
         Some("shear-cell")
     } else if t.contains_key("packed_zone") {
         Some("float")
+    } else if t.contains_key("extruder") {
+        Some("extruder")
     } else {
         None
     }
@@ -330,8 +358,8 @@ pub fn apply(t: &mut toml::Table, path: &Path) -> Result<Applied> {
             let fam = family(t).ok_or_else(|| {
                 at(
                     "minimal = true: the minimal-model tables are per family of scenes (a shear cell, \
-                    [shear_cell]; a float, [packed_zone]) and this scene is neither; list what to \
-                    switch off in simplify = [...] instead"
+                    [shear_cell]; a float, [packed_zone]; an extruder, [extruder]) and this scene is none \
+                    of them; list what to switch off in simplify = [...] instead"
                         .into(),
                 )
             })?;
@@ -437,6 +465,33 @@ mod tests {
     }
 
     #[test]
+    fn short_lubrication_cuts_the_extruders_lubrication_and_refuses_where_it_cannot() {
+        let p = Path::new("s.toml");
+        let ext = "[extruder]\nbarrel_width = 1.0\n[suspension]\nh_min = 0.001\nh_max = 0.05\n";
+        let mut t = table(ext);
+        assert_eq!(family(&t), Some("extruder"));
+        t.insert(
+            "scene".into(),
+            Value::Table(table(r#"simplify = ["short-lubrication"]"#)),
+        );
+        apply(&mut t, p).unwrap();
+        assert_eq!(t["suspension"]["h_max"].as_float(), Some(SHORT_LUBRICATION));
+        for (scene, want) in [
+            (COUPLED, "no lubricated suspension"),
+            ("[suspension]\nh_max = 0.01\n", "h_max is 0.01 already"),
+            ("[suspension]\nh_min = 0.02\n", "h_min = 0.02 is not below"),
+        ] {
+            let mut t = table(scene);
+            t.insert(
+                "scene".into(),
+                Value::Table(table(r#"simplify = ["short-lubrication"]"#)),
+            );
+            let e = apply(&mut t, p).unwrap_err().to_string();
+            assert!(e.contains(want), "{e}");
+        }
+    }
+
+    #[test]
     fn a_simplification_that_does_not_fit_is_refused_with_the_reason() {
         let p = Path::new("s.toml");
         for (simplify, edit, want) in [
@@ -517,7 +572,7 @@ mod tests {
         t.remove("shear_cell");
         t.insert("scene".into(), Value::Table(table("minimal = true")));
         let e = apply(&mut t, &p).unwrap_err().to_string();
-        assert!(e.contains("neither") && e.contains("simplify = [...]"), "{e}");
+        assert!(e.contains("none of them") && e.contains("simplify = [...]"), "{e}");
         let mut t = table(COUPLED);
         t.insert(
             "scene".into(),

@@ -85,3 +85,35 @@ fn a_simplified_scene_is_the_scene_without_what_it_names() {
         "{e}"
     );
 }
+
+/// The extruder's family: `short-lubrication` cuts the lubrication at 0.01 d_ij, and
+/// `minimal = true` applies what scenes/ness2017/minimal.csv shows harmless for an extruder
+/// (measured: nothing, docs/minimal.md).
+#[test]
+fn an_extruder_scene_takes_its_own_table_and_the_lubrication_cut() {
+    let ness = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/ness2017");
+    let base = ness.join("reduced.toml");
+    let full = load(&base, &Default::default()).unwrap();
+    assert_eq!(full.scene.suspension.as_ref().unwrap().h_max, 0.05);
+    let short = load(&base, &set("simplify", "short-lubrication")).unwrap();
+    assert_eq!(short.scene.suspension.as_ref().unwrap().h_max, 0.01);
+    assert_eq!(short.simplified, ["short-lubrication (asked)"]);
+    let mut minimal = toml::Table::new();
+    let mut inner = toml::Table::new();
+    inner.insert("minimal".into(), toml::Value::Boolean(true));
+    minimal.insert("scene".into(), toml::Value::Table(inner));
+    let l = load(&base, &minimal).unwrap();
+    let table = ness.join("minimal.csv");
+    assert_eq!(l.minimal_table.as_deref(), Some(table.as_path()));
+    let want: Vec<&str> = harmless_for(&read_verdicts(&table).unwrap(), "extruder")
+        .iter()
+        .map(|s| s.name)
+        .collect();
+    let got: Vec<&str> = l
+        .simplified
+        .iter()
+        .map(|g| g.split(' ').next().unwrap_or(""))
+        .collect();
+    assert_eq!(got, want, "{:?}", l.simplified);
+    assert_eq!(l.scene.suspension.as_ref().unwrap().h_max, 0.05);
+}
