@@ -572,7 +572,10 @@ mod tests {
         t.remove("shear_cell");
         t.insert("scene".into(), Value::Table(table("minimal = true")));
         let e = apply(&mut t, &p).unwrap_err().to_string();
-        assert!(e.contains("none of them") && e.contains("simplify = [...]"), "{e}");
+        assert!(
+            e.contains("none of them") && e.contains("simplify = [...]"),
+            "{e}"
+        );
         let mut t = table(COUPLED);
         t.insert(
             "scene".into(),
