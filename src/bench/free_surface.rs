@@ -3,8 +3,10 @@
 //! cost of the free surface and of the Bingham local τ each as a ratio; two box sizes, one and two
 //! threads. The free-surface case is a 3D dam break (a column a × 2a against one wall, a a quarter
 //! of the box's length or less to stay below the lid; periodic in z) after 100 steps of collapse, so liquid, interface and gas nodes all
-//! change while it is timed. MLUPS count every node of the box, as the plain kernel's do. The
-//! peer of the issue (lbmpy's D3Q19) is run when installed (`scripts/peer-lbmpy.sh`); not here.
+//! change while it is timed. MLUPS count every node of the box, as the plain kernel's do. With
+//! `--peer`, lbmpy's fastest D3Q19 kernel (AA in place, f64, BGK on a periodic box of the same
+//! size: `scripts/peer-lbmpy.sh` installs it) runs after each size and thread count, and the
+//! plain and free-surface rates are printed over it.
 
 use super::{BenchArgs, median};
 use anyhow::Result;
@@ -88,8 +90,20 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         a.reps
     );
     println!(
-        "{:>14} {:>7} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8}",
-        "box", "threads", "plain", "free surf", "+ Bingham", "FS/plain", "Bingham", "wet"
+        "{:>14} {:>7} {:>10} {:>10} {:>10} {:>8} {:>8} {:>8}{}",
+        "box",
+        "threads",
+        "plain",
+        "free surf",
+        "+ Bingham",
+        "FS/plain",
+        "Bingham",
+        "wet",
+        if a.peer {
+            "      lbmpy plain/lbmpy FS/lbmpy"
+        } else {
+            ""
+        }
     );
     for &n in sizes {
         for threads in [1, 2] {
@@ -110,8 +124,17 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 wet = w;
             }
             let (pm, fm, bm) = (median(&p), median(&f), median(&b));
+            // The peer right after, on the same box and threads (its own median of blocks).
+            let peer = if a.peer {
+                match super::lbm::lbmpy("D3Q19", n, "f64", threads) {
+                    Some(l) => format!(" {:>10.1} {:>11.3} {:>8.3}", l, pm / l, fm / l),
+                    None => "      lbmpy could not run (see above)".into(),
+                }
+            } else {
+                String::new()
+            };
             println!(
-                "{:>14} {:>7} {:>10.1} {:>10.1} {:>10.1} {:>8.3} {:>8.3} {:>8.2}",
+                "{:>14} {:>7} {:>10.1} {:>10.1} {:>10.1} {:>8.3} {:>8.3} {:>8.2}{peer}",
                 format!("{}x{}x{}", n[0], n[1], n[2]),
                 threads,
                 pm,
@@ -127,6 +150,13 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         "MLUPS over every node of the box; FS/plain: the free surface's rate over the plain kernel's; Bingham: \
          with the local tau over without; wet: liquid and interface share of the box when timed."
     );
-    println!("peer (lbmpy D3Q19): not run here (install with scripts/peer-lbmpy.sh)");
+    if a.peer {
+        println!(
+            "lbmpy: its fastest D3Q19 kernel (AA in place, f64) with BGK (SRT) on a periodic box of the same size, \
+             run right after ours; the plain and free-surface kernels here run TRT (more arithmetic than BGK)."
+        );
+    } else {
+        println!("peer (lbmpy D3Q19): add --peer (scripts/peer-lbmpy.sh installs lbmpy)");
+    }
     Ok(())
 }

@@ -338,7 +338,7 @@ fn load() -> f64 {
 /// lbmpy's median MLUPS for one configuration, or None (with a note) if it cannot run. D2Q9 runs
 /// through scripts/peer-lbmpy.sh; D3Q19 calls its driver with the script's venv directly (the
 /// script passes `--stencil D2Q9`), after `peer-lbmpy.sh install` has made sure the venv exists.
-fn lbmpy(lattice: &str, n: [usize; 3], precision: &str, threads: usize) -> Option<f64> {
+pub(super) fn lbmpy(lattice: &str, n: [usize; 3], precision: &str, threads: usize) -> Option<f64> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let script = root.join("scripts/peer-lbmpy.sh");
     let dtype = if precision == "f64" { "float64" } else { "float32" };
