@@ -15,6 +15,9 @@ pub enum CouplingError {
     Units(#[from] lbdem_core::units::lattice::UnitsError),
     #[error(transparent)]
     Dem(#[from] lbdem_dem::DemError),
+    /// The 3D sphere engine's errors (`surface_grains`).
+    #[error(transparent)]
+    Spheres(#[from] lbdem_dem::spheres::SphereError),
     /// Every lattice failure, the instability of the PSM lattice included
     /// (`LbmError::Unstable`: step, node, state and likely cause, from `lbdem_lbm::diagnosis`).
     #[error(transparent)]

@@ -8,7 +8,8 @@
 //! - the weighting B of Eq. 10 ([`weighting`]);
 //! - the PSM lattice: collision of Eqs. 9 and 11, force and moment of Eq. 14 ([`psm`]);
 //! - the liquid confined to a deforming sample, the moving "solid zone" ([`confine`]);
-//! - the sub-cycling driver that holds the hydrodynamic load over the DEM steps ([`driver`]).
+//! - the sub-cycling driver that holds the hydrodynamic load over the DEM steps ([`driver`]);
+//! - 3D grains in a free-surface liquid by moving bounce-back ([`surface_grains`]).
 
 // Kernels index several parallel arrays (velocities, weights, populations) by direction: an index
 // loop says that more plainly than zipped iterators.
@@ -24,6 +25,7 @@ pub mod overlap;
 pub mod psm;
 pub mod remap;
 pub mod solid_fraction;
+pub mod surface_grains;
 pub mod weighting;
 
 /// The units of a coupled run live in `lbdem_core::units::coupled` (the one units module);

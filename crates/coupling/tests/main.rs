@@ -17,4 +17,5 @@ mod resume;
 mod sangani_psm;
 mod settling_disk;
 mod solid_zone;
+mod surface_grains;
 mod torque;

@@ -16,6 +16,10 @@ pub const INTERFACE: u8 = 1;
 pub const LIQUID: u8 = 2;
 /// Solid or inactive node of the domain: bounce-back, no mass.
 pub const WALL: u8 = 3;
+/// Node inside a moving grain (Leonardi et al. 2014 Sect. 5.1): inactive like a wall, but links
+/// into it bounce back with the grain's local velocity (Eq. 19), kept in `FreeSurface::solid_u`.
+/// Nodes become and stop being grain nodes through [`super::solids`].
+pub const GRAIN: u8 = 4;
 
 /// The state of a free-surface run: all a step reads besides the settings, so a clone (or a
 /// serde round trip) continues the run bit for bit.
@@ -26,7 +30,7 @@ pub struct FreeSurface<L: Lattice> {
     /// Post-collision populations of the current time, `f[i * n + node]` (meaningless on gas
     /// and wall nodes).
     pub f: Vec<f64>,
-    /// [`GAS`], [`INTERFACE`], [`LIQUID`] or [`WALL`] per node.
+    /// [`GAS`], [`INTERFACE`], [`LIQUID`], [`WALL`] or [`GRAIN`] per node.
     pub cell: Vec<u8>,
     /// Mass m per node (Eq. 23): ρ on liquid nodes, 0 < m < ρ on interface nodes, 0 on gas.
     pub mass: Vec<f64>,
@@ -34,6 +38,9 @@ pub struct FreeSurface<L: Lattice> {
     /// node: the interface velocity of the reconstruction (Eq. 26) and of new interface nodes.
     pub rho: Vec<f64>,
     pub u: Vec<[f64; 3]>,
+    /// Velocity of the grain surface at each [`GRAIN`] node (Leonardi Eq. 20, lattice units):
+    /// what links into the node bounce back with (Eq. 19). Not read at other nodes.
+    pub solid_u: Vec<[f64; 3]>,
     /// Excess mass of conversions that found no interface neighbour to take it (kept here so the
     /// total stays exact; normally zero).
     pub reservoir: f64,
@@ -56,6 +63,7 @@ impl<L: Lattice> FreeSurface<L> {
             mass: vec![0.0; n],
             rho: vec![1.0; n],
             u: vec![[0.0; 3]; n],
+            solid_u: vec![[0.0; 3]; n],
             reservoir: 0.0,
             step: 0,
             domain,
@@ -123,7 +131,7 @@ impl<L: Lattice> FreeSurface<L> {
         })
     }
 
-    /// Fill fraction ε = m/ρ of node `idx` (Eq. 23): 1 on liquid, 0 on gas and walls.
+    /// Fill fraction ε = m/ρ of node `idx` (Eq. 23): 1 on liquid, 0 on gas, walls and grains.
     pub fn fill(&self, idx: usize) -> f64 {
         match self.cell[idx] {
             LIQUID => 1.0,

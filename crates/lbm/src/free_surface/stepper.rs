@@ -9,7 +9,7 @@
 //! runs in blocks of nodes on rayon's threads, and the conversions run sequentially in node
 //! order, so a run gives the same bits on any number of threads.
 
-use super::cells::{FreeSurface, GAS, INTERFACE, LIQUID, WALL};
+use super::cells::{FreeSurface, GAS, GRAIN, INTERFACE, LIQUID, WALL};
 use super::convert::{Conversions, ConvertScratch, convert};
 use super::mass::{link_exchange, link_weight};
 use super::reconstruct::{atmosphere, from_gas};
@@ -66,7 +66,8 @@ pub struct FreeSurfaceStepper<L: Lattice> {
 
 impl<L: Lattice> FreeSurfaceStepper<L> {
     /// Check the settings and the box. Faces must be periodic or stationary walls (moving walls
-    /// and Zou-He faces are not done with a free surface); solid nodes are stationary walls.
+    /// and Zou-He faces are not done with a free surface); solid nodes of the domain are
+    /// stationary walls, [`GRAIN`] nodes moving ones.
     pub fn new(s: &FreeSurface<L>, settings: Settings, params: FreeSurfaceParams) -> Result<Self, LbmError> {
         let coll = CollideParams::<f64>::new(&settings.collision, settings.force)?;
         if !(params.rho_atm.is_finite() && params.rho_atm > 0.0) {
@@ -244,6 +245,9 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
                             let up = up as usize;
                             match s.cell[up] {
                                 WALL => f_out,
+                                // moving bounce-back (Leonardi Eq. 19 for the outgoing direction
+                                // ī: f_i = f_ī − 6 w_ī ρ u_w·c_ī = f_ī + 6 w_i ρ u_w·c_i)
+                                GRAIN => f_out + moving_wall::<L>(i, s.rho[x], s.solid_u[up]),
                                 GAS => from_gas::<L>(&atm, i, f_out),
                                 k => {
                                     let f_in = s.f[i * n + up];
@@ -278,6 +282,14 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
                 },
             )
     }
+}
+
+/// The moving-wall term 6 w_i ρ u_w·c_i of Leonardi Eq. 19 for a population arriving along c_i
+/// from a grain node moving at `u_w`.
+#[inline]
+pub fn moving_wall<L: Lattice>(i: usize, rho: f64, u_w: [f64; 3]) -> f64 {
+    let c = L::C[i];
+    6.0 * L::W[i] * rho * (u_w[0] * c[0] as f64 + u_w[1] * c[1] as f64 + u_w[2] * c[2] as f64)
 }
 
 /// Nodes per parallel task of the free-surface sweep.
