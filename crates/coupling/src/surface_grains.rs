@@ -20,7 +20,17 @@
 //! 3. **stream and collide** the liquid (`FreeSurfaceStepper`), links into grain nodes bounced
 //!    back with u_w (Eq. 19).
 //!
-//! The DEM then takes its sub-steps with that load held ([`SurfaceCoupled`]). With
+//! The DEM then takes its sub-steps with that load held ([`SurfaceCoupled`]).
+//!
+//! **The velocity term.** Eq. 21's −6 w_i ρ (u_w·c_i) c_i makes the load answer the grain's own
+//! velocity within the step: held over an LBM step it is an explicit drag K with K Δt/m that
+//! grows as the grain shrinks (K ∝ r², m ∝ r³; for rotation ∝ r⁴ against r⁵), and past 2 the grain
+//! rocks from step to step until the liquid beside it passes the Mach limit (seen with pebbles of
+//! 1.6 nodes, `docs/free_surface.md`). With `implicit_velocity` that term is kept as the matrices
+//! of its linear dependence on (v, ω) ([`VelocityResponse`]) and evaluated at every DEM sub-step
+//! with the current velocity, so its limit is K Δt_DEM/m < 2: sub-steps stabilise it. The liquid
+//! still bounces back with the mapping's u_w, so the exchange is then no longer exactly
+//! momentum-conserving (by the term times the velocity change within the step). With
 //! `conserve_momentum`, the liquid's population momentum plus the grains' momentum is conserved to
 //! round-off in a periodic, fully liquid box without gravity (`tests/surface_grains.rs`): every
 //! term the lattice loses, the grains gain. Grains feel gravity in the DEM and buoyancy through the
@@ -33,6 +43,7 @@ use lbdem_lbm::free_surface::{
     Conversions, FreeSurface, FreeSurfaceStepper, GRAIN, INTERFACE, LIQUID, WALL, cover, uncover,
 };
 use lbdem_lbm::{D3Q19, Lattice};
+use nalgebra::{Matrix3, Vector3};
 
 /// No grain covers the node.
 pub const NO_GRAIN: u32 = u32::MAX;
@@ -100,6 +111,34 @@ pub struct SurfaceGrains {
     load: Vec<(Vec3, Vec3)>,
     /// Hand the momentum of covered and uncovered liquid to the grains (module doc).
     pub conserve_momentum: bool,
+    /// Spheres the caller moves itself (frozen in the DEM, where frozen spheres are at rest)
+    /// and the velocity the liquid sees them move at (e.g. a lifted box).
+    pub driven: Option<(std::ops::Range<usize>, Vec3)>,
+    /// Let the velocity term of Eq. 21 (−6 w_i ρ (u_w·c_i) c_i) follow the grain's velocity
+    /// through the DEM sub-steps instead of holding it at the mapping's (module doc, "The
+    /// velocity term"). Off by default (the paper's explicit coupling).
+    pub implicit_velocity: bool,
+    /// Per sphere, with `implicit_velocity`: the load's response to the sphere's own velocity
+    /// and spin (SI).
+    response: Vec<VelocityResponse>,
+}
+
+/// How the velocity term of Eq. 21 on one sphere depends on its velocity v and spin ω:
+/// F = −(A v + C ω), T = −(Cᵀ v + D ω), summed over its links (SI).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VelocityResponse {
+    pub a: Matrix3<f64>,
+    pub c: Matrix3<f64>,
+    pub d: Matrix3<f64>,
+}
+
+impl VelocityResponse {
+    fn load(&self, v: Vec3, w: Vec3) -> (Vec3, Vec3) {
+        let (v, w): (Vector3<f64>, Vector3<f64>) = (v.into(), w.into());
+        let f = -(self.a * v + self.c * w);
+        let t = -(self.c.transpose() * v + self.d * w);
+        (f.into(), t.into())
+    }
 }
 
 impl SurfaceGrains {
@@ -138,6 +177,9 @@ impl SurfaceGrains {
             claimed: Vec::new(),
             load: Vec::new(),
             conserve_momentum: true,
+            driven: None,
+            implicit_velocity: false,
+            response: Vec::new(),
         })
     }
 
@@ -280,7 +322,10 @@ impl SurfaceGrains {
     fn surface_velocity(&self, sys: &SphereSystem, k: usize, d: [f64; 3]) -> [f64; 3] {
         let sc = &self.scale;
         let arm = Vec3::new(d[0], d[1], d[2]) * sc.dx;
-        let u = sys.spheres.vel[k] + sys.spheres.omega[k].cross(arm);
+        let u = match &self.driven {
+            Some((r, v)) if r.contains(&k) => *v,
+            _ => sys.spheres.vel[k] + sys.spheres.omega[k].cross(arm),
+        };
         let f = sc.dt / sc.dx;
         [u.x * f, u.y * f, u.z * f]
     }
@@ -362,6 +407,8 @@ impl SurfaceGrains {
         let rho_a = self.stepper.params().rho_atm;
         let mut force = vec![[0.0f64; 3]; ns];
         let mut torque = vec![[0.0f64; 3]; ns];
+        let implicit = self.implicit_velocity;
+        let mut resp = vec![VelocityResponse::default(); if implicit { ns } else { 0 }];
         let sc = self.scale;
         for &y in &self.owned {
             let y = y as usize;
@@ -381,7 +428,18 @@ impl SurfaceGrains {
                 let c = D3Q19::C[i].map(|v| v as f64);
                 let w = D3Q19::W[i];
                 let cu = u_w[0] * c[0] + u_w[1] * c[1] + u_w[2] * c[2];
-                let mag = 2.0 * s.f[i * n + x] - 2.0 * w * rho_a - 6.0 * w * s.rho[x] * cu;
+                let mag = if implicit {
+                    let k6 = 6.0 * w * s.rho[x];
+                    let cv = Vector3::new(c[0], c[1], c[2]);
+                    let dc = Vector3::new(d[0], d[1], d[2]).cross(&cv);
+                    let r = &mut resp[k];
+                    r.a += cv * cv.transpose() * k6;
+                    r.c += cv * dc.transpose() * k6;
+                    r.d += dc * dc.transpose() * k6;
+                    2.0 * s.f[i * n + x] - 2.0 * w * rho_a
+                } else {
+                    2.0 * s.f[i * n + x] - 2.0 * w * rho_a - 6.0 * w * s.rho[x] * cu
+                };
                 let fl = c.map(|v| mag * v);
                 let arm = [d[0] - 0.5 * c[0], d[1] - 0.5 * c[1], d[2] - 0.5 * c[2]];
                 for a in 0..3 {
@@ -407,6 +465,12 @@ impl SurfaceGrains {
                 Vec3::new(torque[k][0], torque[k][1], torque[k][2]) * (fs * sc.dx),
             ));
         }
+        for r in &mut resp {
+            r.a *= fs * sc.dt / sc.dx;
+            r.c *= fs * sc.dt;
+            r.d *= fs * sc.dx * sc.dt;
+        }
+        self.response = resp;
     }
 
     /// Offset (lattice units) of node `y` from the centre of sphere `k`, the minimum image on
@@ -450,14 +514,23 @@ pub struct SurfaceCoupled<L: SphereLaw> {
     pub substeps: u32,
 }
 
-/// Adds the held hydrodynamic loads.
-struct HeldLoads<'a>(&'a [(Vec3, Vec3)]);
+/// Adds the held hydrodynamic loads, and with `implicit_velocity` their velocity term at the
+/// sphere's current velocity and spin.
+struct HeldLoads<'a>(&'a [(Vec3, Vec3)], &'a [VelocityResponse]);
 
 impl SphereForceHook for HeldLoads<'_> {
-    fn post_force(&mut self, _: f64, _: &SphereSystem, force: &mut [Vec3], torque: &mut [Vec3]) {
+    fn post_force(&mut self, _: f64, sys: &SphereSystem, force: &mut [Vec3], torque: &mut [Vec3]) {
         for (k, (f, t)) in self.0.iter().enumerate() {
             force[k] += *f;
             torque[k] += *t;
+        }
+        for (k, r) in self.1.iter().enumerate() {
+            if sys.is_frozen(k) {
+                continue;
+            }
+            let (f, t) = r.load(sys.spheres.vel[k], sys.spheres.omega[k]);
+            force[k] += f;
+            torque[k] += t;
         }
     }
 }
@@ -494,7 +567,7 @@ impl<L: SphereLaw> SurfaceCoupled<L> {
     /// One LBM step and its DEM sub-steps.
     pub fn step(&mut self) -> Result<Conversions, CouplingError> {
         let conv = self.grains.exchange(&self.sys)?;
-        let mut hook = HeldLoads(&self.grains.load);
+        let mut hook = HeldLoads(&self.grains.load, &self.grains.response);
         for _ in 0..self.substeps {
             self.dem
                 .step_with(&self.params, &self.law, &mut self.sys, &mut hook)

@@ -10,6 +10,7 @@ mod added_mass;
 mod darcy;
 mod dkt;
 mod dkt_uhlmann;
+mod incline;
 mod low_resolution;
 mod momentum;
 mod psm_3d;

@@ -2,6 +2,7 @@
 //! speed-versus-error study (no I/O: callers write what they need).
 
 pub mod dkt;
+pub mod incline;
 pub mod resolution;
 pub mod settling;
 
