@@ -24,13 +24,18 @@
 //!
 //! **The velocity term.** Eq. 21's −6 w_i ρ (u_w·c_i) c_i makes the load answer the grain's own
 //! velocity within the step: held over an LBM step it is an explicit drag K with K Δt/m that
-//! grows as the grain shrinks (K ∝ r², m ∝ r³; for rotation ∝ r⁴ against r⁵), and past 2 the grain
-//! rocks from step to step until the liquid beside it passes the Mach limit (seen with pebbles of
-//! 1.6 nodes, `docs/free_surface.md`). With `implicit_velocity` that term is kept as the matrices
-//! of its linear dependence on (v, ω) ([`VelocityResponse`]) and evaluated at every DEM sub-step
-//! with the current velocity, so its limit is K Δt_DEM/m < 2: sub-steps stabilise it. The liquid
-//! still bounces back with the mapping's u_w, so the exchange is then no longer exactly
-//! momentum-conserving (by the term times the velocity change within the step). With
+//! grows as the grain shrinks and the liquid thins (K ∝ r², m ∝ r³; for rotation r⁴ against r⁵);
+//! a light grain of a couple of nodes then rocks from step to step until the liquid beside it
+//! passes the Mach limit (a pebble of 1.6-node spheres at 1.5 times the liquid's density blows up
+//! in 64 steps at τ = 0.52, `docs/free_surface.md`). With `implicit` the grain's velocity of the
+//! step is solved for instead (after the implicit velocity update of Lowe, Frenkel & Masters 1995
+//! and Nguyen & Ladd 2002, as recalled, not checked against the papers): the term is kept as the
+//! matrices of its linear dependence on (v, ω) ([`VelocityResponse`]), each body's 6 × 6 system
+//! (M + Δt K) u = M u_old + Δt (F_rest + m g) is solved for its velocity and spin u (contacts are
+//! not predicted), the liquid bounces back with that u (Eq. 19-20) and the grain is loaded with
+//! F_rest − K u: the same exchange on both sides, so momentum stays conserved.
+//!
+//! With
 //! `conserve_momentum`, the liquid's population momentum plus the grains' momentum is conserved to
 //! round-off in a periodic, fully liquid box without gravity (`tests/surface_grains.rs`): every
 //! term the lattice loses, the grains gain. Grains feel gravity in the DEM and buoyancy through the
@@ -43,7 +48,8 @@ use lbdem_lbm::free_surface::{
     Conversions, FreeSurface, FreeSurfaceStepper, GRAIN, INTERFACE, LIQUID, WALL, cover, uncover,
 };
 use lbdem_lbm::{D3Q19, Lattice};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use std::ops::AddAssign;
 
 /// No grain covers the node.
 pub const NO_GRAIN: u32 = u32::MAX;
@@ -114,13 +120,9 @@ pub struct SurfaceGrains {
     /// Spheres the caller moves itself (frozen in the DEM, where frozen spheres are at rest)
     /// and the velocity the liquid sees them move at (e.g. a lifted box).
     pub driven: Option<(std::ops::Range<usize>, Vec3)>,
-    /// Let the velocity term of Eq. 21 (−6 w_i ρ (u_w·c_i) c_i) follow the grain's velocity
-    /// through the DEM sub-steps instead of holding it at the mapping's (module doc, "The
-    /// velocity term"). Off by default (the paper's explicit coupling).
-    pub implicit_velocity: bool,
-    /// Per sphere, with `implicit_velocity`: the load's response to the sphere's own velocity
-    /// and spin (SI).
-    response: Vec<VelocityResponse>,
+    /// Solve for each grain's velocity of the step with the velocity term of Eq. 21 (module doc,
+    /// "The velocity term"). Off by default (the paper's explicit coupling).
+    pub implicit: bool,
 }
 
 /// How the velocity term of Eq. 21 on one sphere depends on its velocity v and spin ω:
@@ -178,8 +180,7 @@ impl SurfaceGrains {
             load: Vec::new(),
             conserve_momentum: true,
             driven: None,
-            implicit_velocity: false,
-            response: Vec::new(),
+            implicit: false,
         })
     }
 
@@ -270,9 +271,10 @@ impl SurfaceGrains {
 
     /// Map the grains of `sys`, compute their loads (see [`Self::loads`]) and advance the liquid
     /// one LBM step. The conversions of the step.
-    pub fn exchange(&mut self, sys: &SphereSystem) -> Result<Conversions, CouplingError> {
+    /// `gravity` is the DEM's (m/s²), for the velocity the `implicit` coupling predicts.
+    pub fn exchange(&mut self, sys: &SphereSystem, gravity: Vec3) -> Result<Conversions, CouplingError> {
         let impulse = self.map(sys)?;
-        self.compute_loads(sys, &impulse);
+        self.compute_loads(sys, &impulse, gravity);
         Ok(self.stepper.step(&mut self.liquid)?)
     }
 
@@ -399,7 +401,7 @@ impl SurfaceGrains {
     }
 
     /// Eq. 21 (gauge) over the links into grain nodes, plus the mapping's impulses.
-    fn compute_loads(&mut self, sys: &SphereSystem, impulse: &[[f64; 3]]) {
+    fn compute_loads(&mut self, sys: &SphereSystem, impulse: &[[f64; 3]], gravity: Vec3) {
         let ns = sys.spheres.len();
         let s = &self.liquid;
         let n = s.nodes();
@@ -407,7 +409,7 @@ impl SurfaceGrains {
         let rho_a = self.stepper.params().rho_atm;
         let mut force = vec![[0.0f64; 3]; ns];
         let mut torque = vec![[0.0f64; 3]; ns];
-        let implicit = self.implicit_velocity;
+        let implicit = self.implicit;
         let mut resp = vec![VelocityResponse::default(); if implicit { ns } else { 0 }];
         let sc = self.scale;
         for &y in &self.owned {
@@ -465,12 +467,106 @@ impl SurfaceGrains {
                 Vec3::new(torque[k][0], torque[k][1], torque[k][2]) * (fs * sc.dx),
             ));
         }
-        for r in &mut resp {
-            r.a *= fs * sc.dt / sc.dx;
-            r.c *= fs * sc.dt;
-            r.d *= fs * sc.dx * sc.dt;
+        if implicit {
+            for r in &mut resp {
+                r.a *= fs * sc.dt / sc.dx;
+                r.c *= fs * sc.dt;
+                r.d *= fs * sc.dx * sc.dt;
+            }
+            self.implicit_update(sys, &resp, gravity);
         }
-        self.response = resp;
+    }
+
+    /// The `implicit` coupling (module doc): each mobile body's velocity and spin of the step,
+    /// then every grain node's surface velocity from them (Eq. 20) and each sphere's load
+    /// F_rest − K u.
+    fn implicit_update(&mut self, sys: &SphereSystem, resp: &[VelocityResponse], gravity: Vec3) {
+        let s = &sys.spheres;
+        let cl = &sys.clumps;
+        let dt = self.scale.dt;
+        let ns = s.len();
+        // (v, ω) of every sphere's body as predicted; frozen and driven spheres keep theirs
+        let mut pred: Vec<(Vec3, Vec3)> = (0..ns).map(|k| (s.vel[k], s.omega[k])).collect();
+        let solve = |members: &[(usize, Vec3)], mass: f64, inertia: Matrix3<f64>, v: Vec3, l: Vec3| {
+            let mut k6 = Matrix6::<f64>::zeros();
+            let mut rhs = Vector6::<f64>::zeros();
+            for &(m, b) in members {
+                let r = &resp[m];
+                let bx = skew(b);
+                let c_eff = r.c - r.a * bx;
+                let mut blk = Matrix6::zeros();
+                blk.fixed_view_mut::<3, 3>(0, 0).copy_from(&r.a);
+                blk.fixed_view_mut::<3, 3>(0, 3).copy_from(&c_eff);
+                blk.fixed_view_mut::<3, 3>(3, 0)
+                    .copy_from(&(bx * r.a + r.c.transpose()));
+                blk.fixed_view_mut::<3, 3>(3, 3)
+                    .copy_from(&(bx * c_eff + r.d - r.c.transpose() * bx));
+                k6 += blk;
+                let (f, t) = self.load[m];
+                let (f, t): (Vector3<f64>, Vector3<f64>) = (f.into(), t.into());
+                let t = t + bx * f;
+                rhs.fixed_rows_mut::<3>(0).add_assign(&(f * dt));
+                rhs.fixed_rows_mut::<3>(3).add_assign(&(t * dt));
+            }
+            let mut mm = Matrix6::<f64>::zeros();
+            mm.fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(Matrix3::identity() * mass));
+            mm.fixed_view_mut::<3, 3>(3, 3).copy_from(&inertia);
+            let g: Vector3<f64> = gravity.into();
+            let (v, l): (Vector3<f64>, Vector3<f64>) = (v.into(), l.into());
+            rhs.fixed_rows_mut::<3>(0)
+                .add_assign(&(v * mass + g * (mass * dt)));
+            rhs.fixed_rows_mut::<3>(3).add_assign(&l);
+            let u = (mm + k6 * dt).lu().solve(&rhs)?;
+            Some((Vec3::new(u[0], u[1], u[2]), Vec3::new(u[3], u[4], u[5])))
+        };
+        for k in 0..ns {
+            if sys.is_mobile(k) && !self.is_driven(k) {
+                let i = Matrix3::identity() * s.inertia[k];
+                let l = s.omega[k] * s.inertia[k];
+                if let Some(u) = solve(&[(k, Vec3::ZERO)], s.mass[k], i, s.vel[k], l) {
+                    pred[k] = u;
+                }
+            }
+        }
+        for c in 0..cl.len() {
+            let members: Vec<(usize, Vec3)> = cl
+                .members_of(c)
+                .map(|(m, _)| (m, sys.domain.min_image(s.pos[m] - cl.pos[c])))
+                .collect();
+            let rot = cl.orientation(c).to_rotation_matrix();
+            let i = rot.matrix() * Matrix3::from_diagonal(&cl.inertia[c].into()) * rot.matrix().transpose();
+            if let Some((v, w)) = solve(&members, cl.mass[c], i, cl.vel[c], cl.ang_mom[c]) {
+                for (m, b) in members {
+                    pred[m] = (v + w.cross(b), w);
+                }
+            }
+        }
+        // the surface velocities the liquid bounces back with, and the loads F_rest − K u
+        let f = self.scale.dt / self.scale.dx;
+        for &y in &self.owned {
+            let y = y as usize;
+            let k = self.owner[y] as usize;
+            if self.is_driven(k) || sys.is_frozen(k) {
+                continue;
+            }
+            let d = self.offset(sys, k, y);
+            let (v, w) = pred[k];
+            let u = v + w.cross(Vec3::new(d[0], d[1], d[2]) * self.scale.dx);
+            self.liquid.solid_u[y] = [u.x * f, u.y * f, u.z * f];
+        }
+        for k in 0..ns {
+            if sys.is_frozen(k) || self.is_driven(k) {
+                continue;
+            }
+            let (df, dt_) = resp[k].load(pred[k].0, pred[k].1);
+            self.load[k].0 += df;
+            self.load[k].1 += dt_;
+        }
+    }
+
+    fn is_driven(&self, k: usize) -> bool {
+        self.driven.as_ref().is_some_and(|(r, _)| r.contains(&k))
     }
 
     /// Offset (lattice units) of node `y` from the centre of sphere `k`, the minimum image on
@@ -494,6 +590,11 @@ impl SurfaceGrains {
     }
 }
 
+/// [b]×, the matrix of b × ·.
+fn skew(b: Vec3) -> Matrix3<f64> {
+    Matrix3::new(0.0, -b.z, b.y, b.z, 0.0, -b.x, -b.y, b.x, 0.0)
+}
+
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -514,23 +615,14 @@ pub struct SurfaceCoupled<L: SphereLaw> {
     pub substeps: u32,
 }
 
-/// Adds the held hydrodynamic loads, and with `implicit_velocity` their velocity term at the
-/// sphere's current velocity and spin.
-struct HeldLoads<'a>(&'a [(Vec3, Vec3)], &'a [VelocityResponse]);
+/// Adds the held hydrodynamic loads.
+struct HeldLoads<'a>(&'a [(Vec3, Vec3)]);
 
 impl SphereForceHook for HeldLoads<'_> {
-    fn post_force(&mut self, _: f64, sys: &SphereSystem, force: &mut [Vec3], torque: &mut [Vec3]) {
+    fn post_force(&mut self, _: f64, _: &SphereSystem, force: &mut [Vec3], torque: &mut [Vec3]) {
         for (k, (f, t)) in self.0.iter().enumerate() {
             force[k] += *f;
             torque[k] += *t;
-        }
-        for (k, r) in self.1.iter().enumerate() {
-            if sys.is_frozen(k) {
-                continue;
-            }
-            let (f, t) = r.load(sys.spheres.vel[k], sys.spheres.omega[k]);
-            force[k] += f;
-            torque[k] += t;
         }
     }
 }
@@ -566,8 +658,8 @@ impl<L: SphereLaw> SurfaceCoupled<L> {
 
     /// One LBM step and its DEM sub-steps.
     pub fn step(&mut self) -> Result<Conversions, CouplingError> {
-        let conv = self.grains.exchange(&self.sys)?;
-        let mut hook = HeldLoads(&self.grains.load, &self.grains.response);
+        let conv = self.grains.exchange(&self.sys, self.params.gravity)?;
+        let mut hook = HeldLoads(&self.grains.load);
         for _ in 0..self.substeps {
             self.dem
                 .step_with(&self.params, &self.law, &mut self.sys, &mut hook)

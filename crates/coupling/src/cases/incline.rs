@@ -254,9 +254,14 @@ impl Incline {
         let mut grains = SurfaceGrains::new(liquid, stepper, scale)?;
         // pebbles of a few nodes: the explicit velocity term would make them rock (module doc of
         // `surface_grains`)
-        grains.implicit_velocity = true;
-        // the DEM box is twice as tall as the lattice: the lifted box leaves the lattice's top
-        let size = Vec3::new(spec.extent[0], 2.0 * spec.extent[1], spec.extent[2]);
+        grains.implicit = true;
+        // the DEM box is taller than the lattice: the lifted box leaves the lattice's top
+        let lift_to = e + 2.0 * dx;
+        let size = Vec3::new(
+            spec.extent[0],
+            spec.extent[1] + lift_to + 4.0 * dx,
+            spec.extent[2],
+        );
         let mut sys = SphereSystem::new(Domain3::new(Vec3::ZERO, size, [false; 3])?);
         let pebbles = place_pebbles(spec, &mut sys, [x0, 0.0, z0])?;
         let first_box = sys.spheres.len();
@@ -304,7 +309,7 @@ impl Incline {
             run,
             box_spheres,
             lifted: 0.0,
-            lift_to: e + 2.0 * dx,
+            lift_to,
             pebbles,
             paste_nodes,
         })
