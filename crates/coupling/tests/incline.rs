@@ -103,9 +103,14 @@ fn a_coarse_paste_alone_spreads_keeping_its_mass_until_its_front_passes_the_mach
     // throughout (Fig. 8: "the yielded region ... grows ... to the whole sample"; 0.000 at 0.3 s)
     assert!(shares[0] > 0.5 && shares[1] < 0.05, "rigid shares {shares:?}");
     assert!(worst < 3e-14, "mass drift {worst:e}");
-    let Some(CouplingError::Lbm(LbmError::Unstable { node, step, .. })) = failure else {
+    let Some(CouplingError::Lbm(LbmError::Unstable {
+        node, step, cause, ..
+    })) = failure
+    else {
         panic!("expected the front to pass the Mach limit within 3000 steps: {failure:?}");
     };
+    // the diagnosis names the place (issue 20 item 6)
+    assert!(cause.contains("free surface"), "{cause}");
     let s = &run.run.grains.liquid;
     let x = s.domain.index(node[0], node[1], node[2]);
     let at_surface = s.cell[x] == INTERFACE || s.neighbours(x).any(|j| s.cell[j] == INTERFACE);

@@ -381,3 +381,32 @@ fn a_bingham_column_with_enough_yield_stress_stands() {
     );
     assert!(d0 < 1e-14 && d1 < 1e-14, "mass drift {d0:e}, {d1:e}");
 }
+
+/// Issue 20 item 6: a run that fails at the free surface says so, and names the Bingham floor
+/// when the failing node's τ sat on it. A Bingham dam break whose plastic viscosity lies under
+/// the paper's floor (μ_pl 1e-5: τ_pl 0.50003 < τ_min 0.501) flows at ν_min wherever it shears
+/// fast; with BGK (g = 1e-3) the falling front passes the Mach limit at step 150 (measured).
+/// (g is large so the front is fast: with τ_min 0.52 it fails too, on the Mach number alone.)
+#[test]
+fn a_front_failing_at_the_bingham_floor_is_named() {
+    use lbdem_lbm::{Bingham, LbmError};
+    let run = |tau_min: f64| {
+        let a = 16;
+        let (mut s, mut st) = dam_break(a, 160, 2 * a + 4, 1e-3, Collision::Bgk { tau: 0.501 }).unwrap();
+        st.set_bingham(Some(Bingham {
+            mu_pl: 1e-5,
+            yield_stress: 1e-5,
+            rho: 1.0,
+            tau_min,
+            tau_max: 3.5,
+        }))
+        .unwrap();
+        (0..1000).find_map(|k| st.step(&mut s).err().map(|e| (k, e)))
+    };
+    let Some((k, LbmError::Unstable { cause, .. })) = run(0.501) else {
+        panic!("expected the front to fail within 1000 steps");
+    };
+    assert!(k > 50, "failed at step {k}");
+    assert!(cause.contains("free surface"), "{cause}");
+    assert!(cause.contains("floor"), "{cause}");
+}

@@ -138,6 +138,10 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
     /// Bingham plastic rheology (local τ per node, `bingham`) from the next step on, or the
     /// settings' uniform τ (`None`).
     pub fn set_bingham(&mut self, bingham: Option<Bingham>) -> Result<(), LbmError> {
+        if bingham.is_some() && self.tau.is_none() {
+            // recorded whenever the rheology is on: the failure diagnosis reads it
+            self.tau = Some(vec![f64::NAN; self.f_new.len() / L::Q]);
+        }
         self.bingham = match bingham {
             Some(b) => Some(BinghamRates::new(
                 &b,
@@ -151,7 +155,8 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
 
     /// Record the local relaxation time of every liquid and interface node at each step of a
     /// Bingham run ([`Self::tau`]; Leonardi et al. 2014 Fig. 8 plots the viscosity it gives and
-    /// stops the incline when 95 % of the liquid is at τ_max). Off by default.
+    /// stops the incline when 95 % of the liquid is at τ_max). On from `set_bingham` (the
+    /// failure diagnosis reads it); `false` stops it.
     pub fn record_tau(&mut self, on: bool, nodes: usize) {
         self.tau = on.then(|| vec![f64::NAN; nodes]);
     }
@@ -197,20 +202,54 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
         std::mem::swap(&mut s.u, &mut self.u_new);
         s.step += 1;
         if let Some(x) = bad {
-            let tau = match &self.bingham {
-                Some(b) => 1.0 / b.omega_hi,
-                None => self.settings.collision.tau(),
-            };
-            return Err(BadNode {
-                step: s.step,
-                node: s.domain.coords(x),
-                rho: s.rho[x],
-                u: s.u[x],
-                tau,
-            }
-            .into_error(&self.settings.limits));
+            return Err(self.diagnose(s, x));
         }
         Ok(convert(s, &self.links, self.params.kappa, &mut self.scratch))
+    }
+
+    /// The failure at node `x`, named (issue 20 item 6): the engine's cause (τ near ½, Mach,
+    /// density) with the node's own τ, and whether it sits at the free surface (an interface node
+    /// or next to one: a falling or spreading front) and, with the Bingham rheology, whether its τ
+    /// was at the floor τ_min (fast shear: the clamp's high-shear end) or at τ_max.
+    fn diagnose(&self, s: &FreeSurface<L>, x: usize) -> LbmError {
+        let local = self.tau.as_ref().map(|t| t[x]).filter(|t| t.is_finite());
+        let tau = match (&self.bingham, local) {
+            (Some(_), Some(t)) => t,
+            (Some(b), None) => 1.0 / b.omega_hi,
+            (None, _) => self.settings.collision.tau(),
+        };
+        let mut err = BadNode {
+            step: s.step,
+            node: s.domain.coords(x),
+            rho: s.rho[x],
+            u: s.u[x],
+            tau,
+        }
+        .into_error(&self.settings.limits);
+        if let LbmError::Unstable { cause, .. } = &mut err {
+            let surface = |j: usize| matches!(s.cell[j], INTERFACE | GAS);
+            if s.cell[x] == INTERFACE || s.neighbours(x).any(surface) {
+                cause.push_str(
+                    "; at the free surface (an interface node or next to one: a falling or spreading \
+                     front, where the liquid is fastest and thinnest)",
+                );
+            }
+            if let (Some(b), Some(t)) = (&self.bingham, local) {
+                let (lo, hi) = (1.0 / b.omega_hi, 1.0 / b.omega_lo);
+                if t <= lo * (1.0 + 1e-9) {
+                    cause.push_str(&format!(
+                        "; the Bingham τ there is at its floor τ_min = {lo} (fast shear): raise \
+                         τ_min (e.g. 0.52, which raises the viscosity of fast-sheared liquid) or the \
+                         time step (τ_pl moves away from ½)"
+                    ));
+                } else if t >= hi * (1.0 - 1e-9) {
+                    cause.push_str(&format!(
+                        "; the Bingham τ there is at its ceiling τ_max = {hi} (unyielded liquid)"
+                    ));
+                }
+            }
+        }
+        err
     }
 
     /// Stream, exchange mass and collide every liquid and interface node into the `*_new`
