@@ -3,7 +3,7 @@
 
 use super::models;
 use super::observers::{
-    self, MassBalanced, Progress, Series, Snapshots, Steady, StillOver, WallClock, WallMoved,
+    self, MassBalanced, PasteStopped, Progress, Series, Snapshots, Steady, StillOver, WallClock, WallMoved,
 };
 use super::schema::{Loaded, Physics, Scene, SlowerOver, SlowerThan, TriggerSpec, WallRef};
 use super::timeloop::{self, LoopCfg, Model, Observer, Probe, Trigger};
@@ -29,6 +29,7 @@ pub fn model(l: &Loaded, resume: bool) -> Result<Box<dyn Model>> {
         Physics::Coupled => models::coupled::build(&l.scene, &l.base_dir)
             .with_context(|| format!("scene {} refused", l.path.display()))?,
         Physics::Extruder => Box::new(models::extruder::Extruder::build(&l.scene)?),
+        Physics::Incline => Box::new(models::incline::InclineModel::build(&l.scene)?),
     })
 }
 
@@ -116,6 +117,12 @@ pub fn observers(s: &Scene, total: u64) -> Result<(Vec<Box<dyn Observer>>, Trigg
     }
     if s.extruder.as_ref().is_some_and(|e| e.stop_when_steady) {
         obs.push(Box::new(MassBalanced {
+            trigger: series.clone(),
+        }));
+    }
+    if let Some(i) = &s.incline {
+        obs.push(Box::new(PasteStopped {
+            share: i.stop_share,
             trigger: series.clone(),
         }));
     }

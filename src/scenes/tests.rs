@@ -72,6 +72,7 @@ mod dry;
 mod extruder;
 mod float;
 mod fluid;
+mod incline;
 mod initial;
 mod initial_fluid;
 mod minimal;

@@ -74,6 +74,8 @@ pub enum Probe {
     MeanLiquidSpeed,
     /// Since when an extruder's mass balance has held (s), if it holds now.
     SteadySince,
+    /// Share of an incline's paste at its largest viscosity (τ_max).
+    RigidShare,
 }
 
 /// When an observer acts, in steps (a `count` or `at` of the scene file is turned into these

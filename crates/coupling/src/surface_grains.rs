@@ -203,6 +203,25 @@ impl SurfaceGrains {
         Ok(s)
     }
 
+    /// Take `state` (written by [`Self::state`] for a lattice of the same box and settings).
+    pub fn set_state(&mut self, state: SurfaceGrainsState) -> Result<(), CouplingError> {
+        let n = self.liquid.nodes();
+        if state.liquid.nodes() != n
+            || state.liquid.domain.n != self.liquid.domain.n
+            || state.owner.len() != n
+            || state.owned.iter().any(|&x| x as usize >= n)
+        {
+            return Err(CouplingError::Unsupported(format!(
+                "the state's lattice of {:?} nodes is not this one's {:?}",
+                state.liquid.domain.n, self.liquid.domain.n
+            )));
+        }
+        self.liquid = state.liquid;
+        self.owner = state.owner;
+        self.owned = state.owned;
+        Ok(())
+    }
+
     pub fn state(&self) -> SurfaceGrainsState {
         SurfaceGrainsState {
             liquid: self.liquid.clone(),

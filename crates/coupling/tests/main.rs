@@ -11,7 +11,6 @@ mod darcy;
 mod dkt;
 mod dkt_uhlmann;
 mod incline;
-mod incline_run;
 mod low_resolution;
 mod momentum;
 mod psm_3d;

@@ -480,7 +480,7 @@ impl<T: Real> Model for CoupledModel<T> {
                 self.steps_done(),
             ),
             Probe::MeanLiquidSpeed => Some(self.liquid_speeds().0),
-            Probe::SteadySince => None,
+            Probe::SteadySince | Probe::RigidShare => None,
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {

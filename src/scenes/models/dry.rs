@@ -186,7 +186,7 @@ impl Model for Dry {
                 k,
                 self.sys.step,
             ),
-            Probe::MeanLiquidSpeed | Probe::SteadySince => None,
+            Probe::MeanLiquidSpeed | Probe::SteadySince | Probe::RigidShare => None,
         }
     }
     fn snapshot(&self, dir: &Path) -> Result<Vec<(&'static str, PathBuf)>> {

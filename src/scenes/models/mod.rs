@@ -7,6 +7,7 @@ pub mod coupled;
 pub mod dry;
 pub mod extruder;
 pub mod fluid;
+pub mod incline;
 pub mod mass_control;
 pub mod packed_zone;
 pub mod shear_cell;

@@ -10,4 +10,4 @@ mod stop;
 pub use progress::Progress;
 pub use series::{FILE as SERIES_FILE, Series};
 pub use snapshots::Snapshots;
-pub use stop::{MassBalanced, SlowerThan, Steady, StillOver, WallClock, WallMoved};
+pub use stop::{MassBalanced, PasteStopped, SlowerThan, Steady, StillOver, WallClock, WallMoved};

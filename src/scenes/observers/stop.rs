@@ -185,6 +185,32 @@ impl Observer for WallClock {
 /// Stop when an extruder's mass balance holds (`[extruder] stop_when_steady`): the insertion
 /// and removal rates over the trailing window agree within the tolerance (Ness et al. 2017's
 /// steady-state check; `lbdem_dem::spheres::extruder::balance`).
+/// Stops an incline once its paste has stopped: `share` of it at τ_max (Leonardi et al. 2014:
+/// "stopped when 95 % of the fluid has reached the maximum viscosity").
+pub struct PasteStopped {
+    pub share: f64,
+    pub trigger: Trigger,
+}
+
+impl Observer for PasteStopped {
+    fn name(&self) -> &'static str {
+        "stop_share"
+    }
+    fn trigger(&self) -> &Trigger {
+        &self.trigger
+    }
+    fn observe(&mut self, m: &mut dyn Model, _cx: &LoopCtx) -> Result<Flow> {
+        Ok(match m.probe(Probe::RigidShare) {
+            Some(r) if r >= self.share => Flow::Stop(format!(
+                "the paste stopped: {:.1} % of it at the largest viscosity (step {})",
+                100.0 * r,
+                m.steps_done()
+            )),
+            _ => Flow::Continue,
+        })
+    }
+}
+
 pub struct MassBalanced {
     pub trigger: Trigger,
 }

@@ -144,6 +144,9 @@ pub struct Scene {
     pub extruder: Option<ExtruderSection>,
     #[serde(default)]
     pub suspension: Option<SuspensionSection>,
+    /// Leonardi et al. (2014)'s concrete incline (3D free-surface LBM-DEM): a scene of its own.
+    #[serde(default)]
+    pub incline: Option<lbdem_coupling::cases::incline::InclineSpec>,
     pub run: RunSection,
     #[serde(default)]
     pub output: OutputSection,
@@ -161,6 +164,8 @@ pub enum Physics {
     Coupled,
     /// Ness et al. (2017)'s extruder: 3D lubricated spheres ([extruder], [suspension]).
     Extruder,
+    /// Leonardi et al. (2014)'s incline: free-surface Bingham paste with pebbles ([incline]).
+    Incline,
 }
 
 #[derive(Debug)]
@@ -335,6 +340,9 @@ fn suggestion(msg: &str) -> Option<(String, String)> {
 impl Scene {
     /// What the scene simulates, checking that every section it has is used by that physics.
     pub fn physics(&self) -> Result<Physics> {
+        if self.incline.is_some() {
+            return self.incline_physics();
+        }
         if self.extruder.is_some() {
             return self.extruder_physics();
         }
@@ -449,6 +457,59 @@ impl Scene {
         }
         self.check_run(grains, liquid)?;
         Ok(physics)
+    }
+
+    /// An `[incline]` scene: its own lattice, paste, pebbles and box, so no other physics
+    /// section.
+    fn incline_physics(&self) -> Result<Physics> {
+        let others: [(&str, bool); 20] = [
+            (
+                "[domain]",
+                !self.domain.lo.is_empty() || !self.domain.hi.is_empty(),
+            ),
+            ("[particles]", self.particles.is_some()),
+            ("[contact]", self.contact.is_some()),
+            ("[wall_contact]", self.wall_contact.is_some()),
+            ("[[walls]]", !self.walls.is_empty()),
+            ("[bonds]", self.bonds.is_some()),
+            ("[membrane]", self.membrane.is_some()),
+            ("[dem]", self.dem.is_some()),
+            ("[compress]", self.compress.is_some()),
+            ("[shear_cell]", self.shear_cell.is_some()),
+            ("[packed_zone]", self.packed_zone.is_some()),
+            ("[fluid]", self.fluid.is_some()),
+            ("[lattice]", self.lattice.is_some()),
+            ("[boundaries]", self.boundaries.is_some()),
+            ("[forcing]", self.forcing.is_some()),
+            ("[[obstacles]]", !self.obstacles.is_empty()),
+            ("[mask]", self.mask.is_some()),
+            ("[coupling]", self.coupling.is_some()),
+            ("[extruder]", self.extruder.is_some()),
+            ("[suspension]", self.suspension.is_some()),
+        ];
+        if let Some((s, _)) = others.iter().find(|(_, on)| *on) {
+            bail!(
+                "{s} is given in an [incline] scene, which builds its own lattice, paste, pebbles and \
+                 box from [incline]; remove {s}"
+            );
+        }
+        let r = &self.run;
+        if r.until_slower_than.is_some() || r.until_wall_moved.is_some() || r.until_steady.is_some() {
+            bail!(
+                "[run] until_slower_than / until_wall_moved / until_steady are for 2D scenes; an incline \
+                 stops when [incline] stop_share of its paste is at tau_max"
+            );
+        }
+        if self.output.series.when.is_some() || self.output.snapshots.when.is_some() {
+            bail!(
+                "[output] when = {{...}} triggers read 2D quantities; use every, count or at in an incline scene"
+            );
+        }
+        if let Some(i) = &self.incline {
+            i.check().map_err(|e| anyhow::anyhow!("[incline]: {e}"))?;
+        }
+        self.check_run(true, true)?;
+        Ok(Physics::Incline)
     }
 
     /// An `[extruder]` scene: 3D spheres with their own box, so none of the 2D engine's or the

@@ -74,6 +74,28 @@ pub struct InclineSpec {
     pub restitution: f64,
     /// DEM steps per LBM step.
     pub substeps: u32,
+    /// The implicit velocity update of the coupling (`SurfaceGrains::implicit`); the paper's
+    /// pebbles of 1-3 nodes rock without it.
+    #[serde(default = "yes")]
+    pub implicit: bool,
+    /// Stop when this share of the paste is at τ_max (the paper: 95 %).
+    #[serde(default = "stop_share")]
+    pub stop_share: f64,
+}
+
+fn yes() -> bool {
+    true
+}
+fn stop_share() -> f64 {
+    0.95
+}
+
+/// What an incline run needs besides its spec to continue bit for bit.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct InclineState {
+    pub grains: crate::surface_grains::SurfaceGrainsState,
+    pub system: SphereSystem,
+    pub lifted: f64,
 }
 
 impl InclineSpec {
@@ -107,16 +129,19 @@ impl InclineSpec {
             friction: 0.5,
             restitution: 0.5,
             substeps: 20,
+            implicit: true,
+            stop_share: 0.95,
         }
     }
 
-    /// The same case on a lattice `factor` times coarser, Δt scaled with Δx (acoustic scaling:
-    /// the lattice velocities stay; the lattice viscosity grows with the factor, so τ_pl moves
-    /// away from ½).
+    /// The same case on a lattice `factor` times coarser with Δt scaled by factor² (diffusive
+    /// scaling): the lattice viscosity, so τ_pl and the whole Bingham clamp, stay the paper's,
+    /// the lattice velocities grow with the factor (the paper's are small: 0.01 at its largest
+    /// speed, 0.667 m/s) and the steps to a given time fall with its square.
     pub fn coarsened(&self, factor: f64) -> Self {
         Self {
             dx: self.dx * factor,
-            dt: self.dt * factor,
+            dt: self.dt * factor * factor,
             ..self.clone()
         }
     }
@@ -145,7 +170,8 @@ impl InclineSpec {
         Vec3::new(9.81 * t.sin(), -9.81 * t.cos(), 0.0)
     }
 
-    fn check(&self) -> Result<(), CouplingError> {
+    /// Refuse what cannot be built, naming the parameter.
+    pub fn check(&self) -> Result<(), CouplingError> {
         let bad = |name: &str, v: f64, why: &str| {
             Err(CouplingError::Unsupported(format!("incline {name} = {v}: {why}")))
         };
@@ -190,6 +216,13 @@ impl InclineSpec {
         if self.substeps == 0 {
             return bad("substeps", 0.0, "give at least 1 DEM step per LBM step");
         }
+        if !(self.stop_share > 0.0 && self.stop_share <= 1.0) {
+            return bad(
+                "stop_share",
+                self.stop_share,
+                "give a share in (0, 1] (the paper: 0.95)",
+            );
+        }
         Ok(())
     }
 }
@@ -218,12 +251,13 @@ impl Incline {
         let g_lu = g * (dt * dt / dx);
         let wall = Face::Wall { velocity: [0.0; 3] };
         let dom = Domain::new(n, [wall; 6]);
-        let e = spec.box_edge;
-        let (x0, z0) = (spec.box_from_top, 0.5 * (spec.extent[2] - e));
-        let inside = |p: [usize; 3]| {
-            let c = p.map(|k| (k as f64 + 0.5) * dx);
-            c[0] > x0 && c[0] < x0 + e && c[1] < e && c[2] > z0 && c[2] < z0 + e
-        };
+        // the cube on whole nodes: `ne` of them along each edge, from node `i0` down the board
+        // and `k0` across (centred), so its volume is ne³ dx³ whatever the rounding
+        let ne = (spec.box_edge / dx).round() as usize;
+        let (i0, k0) = ((spec.box_from_top / dx).round() as usize, (n[2] - ne) / 2);
+        let (e, x0, z0) = (ne as f64 * dx, i0 as f64 * dx, k0 as f64 * dx);
+        let inside =
+            |p: [usize; 3]| (i0..i0 + ne).contains(&p[0]) && p[1] < ne && (k0..k0 + ne).contains(&p[2]);
         let liquid = FreeSurface::<D3Q19>::new(dom, |p| {
             let fill = if inside(p) { 1.0 } else { 0.0 };
             let depth = (e / dx - 0.5 - p[1] as f64).max(0.0);
@@ -252,9 +286,7 @@ impl Incline {
             origin: [0.0; 3],
         };
         let mut grains = SurfaceGrains::new(liquid, stepper, scale)?;
-        // pebbles of a few nodes: the explicit velocity term would make them rock (module doc of
-        // `surface_grains`)
-        grains.implicit = true;
+        grains.implicit = spec.implicit;
         // the DEM box is taller than the lattice: the lifted box leaves the lattice's top
         let lift_to = e + 2.0 * dx;
         let size = Vec3::new(
@@ -263,7 +295,7 @@ impl Incline {
             spec.extent[2],
         );
         let mut sys = SphereSystem::new(Domain3::new(Vec3::ZERO, size, [false; 3])?);
-        let pebbles = place_pebbles(spec, &mut sys, [x0, 0.0, z0])?;
+        let pebbles = place_pebbles(spec, &mut sys, [x0, 0.0, z0], e)?;
         let first_box = sys.spheres.len();
         let rb = 1.5 * dx;
         let step = 1.25 * dx;
@@ -332,6 +364,64 @@ impl Incline {
         self.run.step()
     }
 
+    /// The state to checkpoint.
+    pub fn state(&self) -> InclineState {
+        InclineState {
+            grains: self.run.grains.state(),
+            system: self.run.sys.clone(),
+            lifted: self.lifted,
+        }
+    }
+
+    /// Continue from `state` (written by [`Self::state`] for the same spec).
+    pub fn restore(&mut self, state: InclineState) -> Result<(), CouplingError> {
+        if state.system.spheres.len() != self.run.sys.spheres.len() {
+            return Err(CouplingError::Unsupported(format!(
+                "the checkpoint has {} spheres where this incline has {}: it is not of this scene",
+                state.system.spheres.len(),
+                self.run.sys.spheres.len()
+            )));
+        }
+        self.run.grains.set_state(state.grains)?;
+        self.run.sys = state.system;
+        self.run.dem = lbdem_dem::spheres::SphereStepper::new();
+        self.lifted = state.lifted;
+        Ok(())
+    }
+
+    /// The largest pebble speed (m/s).
+    pub fn max_pebble_speed(&self) -> f64 {
+        let s = &self.run.sys.spheres;
+        (0..self.box_spheres.start)
+            .map(|k| s.vel[k].norm())
+            .fold(0.0, f64::max)
+    }
+
+    /// Runout (m, down the board from the box's downslope side) and width (m, across) of the
+    /// footprint: the columns at least half a node thick.
+    pub fn footprint(&self) -> (f64, f64) {
+        let spec = &self.spec;
+        let [nx, _, nz] = spec.nodes();
+        let th = self.thickness();
+        let (mut x_max, mut z_lo, mut z_hi) = (0usize, usize::MAX, 0usize);
+        for z in 0..nz {
+            for x in 0..nx {
+                if th[x + nx * z] > 0.5 * spec.dx {
+                    x_max = x_max.max(x + 1);
+                    z_lo = z_lo.min(z);
+                    z_hi = z_hi.max(z + 1);
+                }
+            }
+        }
+        if z_lo == usize::MAX {
+            return (0.0, 0.0);
+        }
+        (
+            x_max as f64 * spec.dx - (spec.box_from_top + spec.box_edge),
+            (z_hi - z_lo) as f64 * spec.dx,
+        )
+    }
+
     /// Physical time (s).
     pub fn time(&self) -> f64 {
         self.run.grains.liquid.step as f64 * self.spec.dt
@@ -394,11 +484,13 @@ impl Incline {
     }
 }
 
-/// Place the pebbles in the cube with its low corner at `corner` (module doc); how many.
+/// Place the pebbles in the cube of edge `e` with its low corner at `corner` (module doc); how
+/// many.
 pub fn place_pebbles(
     spec: &InclineSpec,
     sys: &mut SphereSystem,
     corner: [f64; 3],
+    e: f64,
 ) -> Result<usize, CouplingError> {
     if spec.pebbles == 0 {
         return Ok(0);
@@ -414,7 +506,6 @@ pub fn place_pebbles(
         .map(|_| spec.r_min + (spec.r_max - spec.r_min) * rng.random_range(0.0..1.0))
         .collect();
     radii.sort_by(|a, b| b.total_cmp(a));
-    let e = spec.box_edge;
     let mut placed: Vec<(Vec3, f64)> = Vec::with_capacity(radii.len());
     for (k, &r) in radii.iter().enumerate() {
         let rb = bound * r;
