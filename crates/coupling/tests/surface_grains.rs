@@ -237,7 +237,7 @@ fn a_grain_dropped_into_the_liquid_floats_at_archimedes_depth_and_the_mass_is_ke
     );
     // measured 2.6e-14
     assert!(drift < 5e-14, "mass drift {drift:e}");
-    // measured 0.425 at 4.5 nodes of radius (the staircase sphere; 0.4986 at 7.5, the ignored
+    // measured 0.406 at 4.5 nodes of radius (the staircase sphere; 0.4973 at 7.5, the ignored
     // test below)
     assert!((submerged - 0.5).abs() < 0.15, "submerged fraction {submerged}");
 }
@@ -246,9 +246,9 @@ fn a_grain_dropped_into_the_liquid_floats_at_archimedes_depth_and_the_mass_is_ke
 #[ignore = "finer floating grain (about 45 s): cargo test -p lbdem-coupling --test coupling -- --ignored surface_grains::"]
 fn a_finer_floating_grain() {
     let (submerged, _, drift) = float(7.5, 0.5, 34, 22, 9000);
-    // measured 1.5e-13 (46 000 nodes) and 0.4986
+    // measured 1.5e-13 (46 000 nodes) and 0.4973
     assert!(drift < 3e-13, "mass drift {drift:e}");
-    assert!((submerged - 0.5).abs() < 0.003, "submerged fraction {submerged}");
+    assert!((submerged - 0.5).abs() < 0.005, "submerged fraction {submerged}");
 }
 
 #[test]

@@ -31,7 +31,7 @@ fn the_quick_incline_lifts_its_box_and_spreads_its_paste_keeping_mass_and_volume
         column(t.path(), "series.csv", "mass_drift"),
     );
     for k in 0..time.len() {
-        // the box rises at 0.15 m/s; the paste's mass is kept (measured ≤ 2.1e-15)
+        // the box rises at 0.15 m/s; the paste's mass is kept (measured ≤ 5.9e-15)
         assert!(
             (lifted[k] - 0.15 * time[k]).abs() < 1e-9,
             "lifted {} at {} s",
@@ -39,7 +39,7 @@ fn the_quick_incline_lifts_its_box_and_spreads_its_paste_keeping_mass_and_volume
             time[k]
         );
         assert!(
-            drift[k].abs() < 5e-15,
+            drift[k].abs() < 1.2e-14,
             "mass drift {:e} at {} s",
             drift[k],
             time[k]
@@ -51,12 +51,12 @@ fn the_quick_incline_lifts_its_box_and_spreads_its_paste_keeping_mass_and_volume
         last > 0.08 && runout.windows(2).all(|w| w[1] >= w[0] - 0.011),
         "runout {runout:?}"
     );
-    // the paste on the board: Σ thickness dx² is 3.05e-3 m³ at 0.3 s against the cube's
-    // 3.375e-3 (15³ nodes of 1 cm) while the mass is kept: the paste's mean density rose 11 %
-    // (docs/free_surface.md, "The incline": not understood yet); between 2.5e-3 and the cube's
+    // the paste on the board, Σ thickness dx², is the cube's 15³ nodes of 1 cm (3.375e-3 m³):
+    // measured 3.406e-3 (+0.9 %: the paste started hydrostatic, up to 2.4 % denser at the bottom,
+    // and spreads thin)
     let th = column(t.path(), "snapshots/thickness_000000400.csv", "thickness");
     let volume: f64 = th.iter().sum::<f64>() * 1e-4;
-    assert!(volume > 2.5e-3 && volume < 3.4e-3, "volume {volume}");
+    assert!((volume / 3.375e-3 - 1.0).abs() < 0.02, "volume {volume}");
     let mu = column(t.path(), "snapshots/section_000000400.csv", "viscosity");
     assert!(mu.iter().any(|m| m.is_finite()) && mu.iter().any(|m| m.is_nan()));
 }
