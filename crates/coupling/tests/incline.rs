@@ -56,10 +56,10 @@ fn a_coarse_paste_alone_spreads_keeping_its_mass_until_its_front_passes_the_mach
     // The paper's paste without pebbles on a lattice 5 times coarser (10 mm; Δt 7.5e-4 s, scaled
     // with dx² so that τ_pl is the paper's 0.501875). It slumps and runs down the board (0.14 m
     // past the box at 0.3 s), the mass kept to 6e-15, then a node at the foot of the front passes
-    // the Mach limit at step 523 (t = 0.39 s, measured). Issue 20 item 6's "Mach limit in the
+    // the Mach limit at step 501 (t = 0.38 s, measured). Issue 20 item 6's "Mach limit in the
     // falling front", provoked here: the run must stop there with the engine's diagnosis, at a
     // node of the free surface or next to it, and say so. A floor τ_min = 0.52 postpones it
-    // (step 829), 0.6 to step 2336 (measured): not the fix.
+    // (step 860), 0.6 to step 1918 (measured): not the fix.
     let spec = InclineSpec {
         pebbles: 0,
         ..InclineSpec::leonardi2014().coarsened(5.0)
