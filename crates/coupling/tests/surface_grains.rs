@@ -312,7 +312,7 @@ fn a_coupled_run_resumes_bit_for_bit() {
     );
 }
 
-/// ten Cate et al. (2002) Table 1 (as `../shared/REFERENCES.md`): liquid density (kg/m³),
+/// ten Cate et al. (2002) Table 1 (as the project's reference list quotes it): liquid density (kg/m³),
 /// dynamic viscosity (Pa s) and the measured terminal velocity (m/s) of cases E1-E4.
 const TEN_CATE: [(f64, f64, f64); 4] = [
     (970.0, 0.373, 0.038),

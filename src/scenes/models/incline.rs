@@ -46,6 +46,15 @@ impl InclineModel {
     }
 }
 
+/// Node centres (m) of an `na` × `nb` plane of the lattice, first index fastest (the order of
+/// `Incline::thickness` and `Incline::viscosity_section`).
+fn node_grid(na: usize, nb: usize, dx: f64) -> (Vec<f64>, Vec<f64>) {
+    let centre = |k: usize| (k as f64 + 0.5) * dx;
+    (0..nb)
+        .flat_map(|b| (0..na).map(move |a| (centre(a), centre(b))))
+        .unzip()
+}
+
 /// The series columns after `time`.
 pub const COLUMNS: [&str; 6] = [
     "lifted",
@@ -99,15 +108,8 @@ impl Model for InclineModel {
         let spec = self.spec();
         let [nx, ny, nz] = spec.nodes();
         let step = self.steps_done();
-        let centre = |k: usize| (k as f64 + 0.5) * spec.dx;
         let th = self.run.thickness();
-        let (mut x, mut z) = (Vec::with_capacity(nx * nz), Vec::with_capacity(nx * nz));
-        for k in 0..nz {
-            for i in 0..nx {
-                x.push(centre(i));
-                z.push(centre(k));
-            }
-        }
+        let (x, z) = node_grid(nx, nz, spec.dx);
         let thickness = PathBuf::from(format!("snapshots/thickness_{step:09}.csv"));
         write_table(
             &dir.join(&thickness),
@@ -118,13 +120,7 @@ impl Model for InclineModel {
             ],
         )?;
         let mu = self.run.viscosity_section();
-        let (mut sx, mut sy) = (Vec::with_capacity(nx * ny), Vec::with_capacity(nx * ny));
-        for j in 0..ny {
-            for i in 0..nx {
-                sx.push(centre(i));
-                sy.push(centre(j));
-            }
-        }
+        let (sx, sy) = node_grid(nx, ny, spec.dx);
         let section = PathBuf::from(format!("snapshots/section_{step:09}.csv"));
         write_table(
             &dir.join(&section),

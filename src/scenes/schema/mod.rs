@@ -459,10 +459,10 @@ impl Scene {
         Ok(physics)
     }
 
-    /// An `[incline]` scene: its own lattice, paste, pebbles and box, so no other physics
-    /// section.
-    fn incline_physics(&self) -> Result<Physics> {
-        let others: [(&str, bool); 20] = [
+    /// The 2D engine's and the liquid's sections, each with whether the scene gives it: what a
+    /// 3D scene with its own box (`[extruder]`, `[incline]`) must not have.
+    fn planar_sections(&self) -> [(&'static str, bool); 18] {
+        [
             (
                 "[domain]",
                 !self.domain.lo.is_empty() || !self.domain.hi.is_empty(),
@@ -484,27 +484,41 @@ impl Scene {
             ("[[obstacles]]", !self.obstacles.is_empty()),
             ("[mask]", self.mask.is_some()),
             ("[coupling]", self.coupling.is_some()),
+        ]
+    }
+
+    /// Refuse the 2D stop conditions and output triggers in a 3D scene of kind `kind`, which
+    /// stops as `stops` says.
+    fn refuse_planar_stops(&self, kind: &str, stops: &str) -> Result<()> {
+        let r = &self.run;
+        if r.until_slower_than.is_some() || r.until_wall_moved.is_some() || r.until_steady.is_some() {
+            bail!("[run] until_slower_than / until_wall_moved / until_steady are for 2D scenes; {stops}");
+        }
+        if self.output.series.when.is_some() || self.output.snapshots.when.is_some() {
+            bail!(
+                "[output] when = {{...}} triggers read 2D quantities; use every, count or at in an {kind} scene"
+            );
+        }
+        Ok(())
+    }
+
+    /// An `[incline]` scene: its own lattice, paste, pebbles and box, so no other physics
+    /// section.
+    fn incline_physics(&self) -> Result<Physics> {
+        let others = self.planar_sections().into_iter().chain([
             ("[extruder]", self.extruder.is_some()),
             ("[suspension]", self.suspension.is_some()),
-        ];
-        if let Some((s, _)) = others.iter().find(|(_, on)| *on) {
+        ]);
+        if let Some((s, _)) = others.into_iter().find(|(_, on)| *on) {
             bail!(
                 "{s} is given in an [incline] scene, which builds its own lattice, paste, pebbles and \
                  box from [incline]; remove {s}"
             );
         }
-        let r = &self.run;
-        if r.until_slower_than.is_some() || r.until_wall_moved.is_some() || r.until_steady.is_some() {
-            bail!(
-                "[run] until_slower_than / until_wall_moved / until_steady are for 2D scenes; an incline \
-                 stops when [incline] stop_share of its paste is at tau_max"
-            );
-        }
-        if self.output.series.when.is_some() || self.output.snapshots.when.is_some() {
-            bail!(
-                "[output] when = {{...}} triggers read 2D quantities; use every, count or at in an incline scene"
-            );
-        }
+        self.refuse_planar_stops(
+            "incline",
+            "an incline stops when [incline] stop_share of its paste is at tau_max",
+        )?;
         if let Some(i) = &self.incline {
             i.check().map_err(|e| anyhow::anyhow!("[incline]: {e}"))?;
         }
@@ -515,30 +529,7 @@ impl Scene {
     /// An `[extruder]` scene: 3D spheres with their own box, so none of the 2D engine's or the
     /// liquid's sections.
     fn extruder_physics(&self) -> Result<Physics> {
-        let others: [(&str, bool); 18] = [
-            (
-                "[domain]",
-                !self.domain.lo.is_empty() || !self.domain.hi.is_empty(),
-            ),
-            ("[particles]", self.particles.is_some()),
-            ("[contact]", self.contact.is_some()),
-            ("[wall_contact]", self.wall_contact.is_some()),
-            ("[[walls]]", !self.walls.is_empty()),
-            ("[bonds]", self.bonds.is_some()),
-            ("[membrane]", self.membrane.is_some()),
-            ("[dem]", self.dem.is_some()),
-            ("[compress]", self.compress.is_some()),
-            ("[shear_cell]", self.shear_cell.is_some()),
-            ("[packed_zone]", self.packed_zone.is_some()),
-            ("[fluid]", self.fluid.is_some()),
-            ("[lattice]", self.lattice.is_some()),
-            ("[boundaries]", self.boundaries.is_some()),
-            ("[forcing]", self.forcing.is_some()),
-            ("[[obstacles]]", !self.obstacles.is_empty()),
-            ("[mask]", self.mask.is_some()),
-            ("[coupling]", self.coupling.is_some()),
-        ];
-        if let Some((s, _)) = others.iter().find(|(_, on)| *on) {
+        if let Some((s, _)) = self.planar_sections().iter().find(|(_, on)| *on) {
             bail!(
                 "{s} is given in an [extruder] scene, which builds its own box and 3D grains \
                  ([extruder] and [suspension]); remove {s}"
@@ -547,18 +538,10 @@ impl Scene {
         let (Some(e), Some(s)) = (&self.extruder, &self.suspension) else {
             bail!("[extruder] needs a [suspension] section (diameters, density, viscosity, k_n, mu_p, mu_w)");
         };
-        let r = &self.run;
-        if r.until_slower_than.is_some() || r.until_wall_moved.is_some() || r.until_steady.is_some() {
-            bail!(
-                "[run] until_slower_than / until_wall_moved / until_steady are for 2D scenes; an extruder \
-                 stops at its mass balance with [extruder] stop_when_steady = true"
-            );
-        }
-        if self.output.series.when.is_some() || self.output.snapshots.when.is_some() {
-            bail!(
-                "[output] when = {{...}} triggers read 2D quantities; use every, count or at in an extruder scene"
-            );
-        }
+        self.refuse_planar_stops(
+            "extruder",
+            "an extruder stops at its mass balance with [extruder] stop_when_steady = true",
+        )?;
         extruder::check(e, s)?;
         self.check_run(true, false)?;
         Ok(Physics::Extruder)

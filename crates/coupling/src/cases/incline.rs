@@ -99,7 +99,7 @@ pub struct InclineState {
 }
 
 impl InclineSpec {
-    /// Leonardi et al. (2014) Sect. 6 (`../shared/REPRODUCTION.md`): lattice 350 × 80 × 250 at
+    /// Leonardi et al. (2014) Sect. 6 (the project's reproduction list): lattice 350 × 80 × 250 at
     /// 2 mm (the paper's 350 × 250 × 80 with y normal to the board), Δt 3e-5 s, 15°, 150 mm box
     /// lifted at 0.15 m/s, μ_pl 0.15 Pa s, σ_y 62 Pa, τ in [0.501, 3.5], 1000 pebbles of R 4-8 mm
     /// at 2680 kg/m³. Not in the paper, chosen here: the box 50 mm from the upslope end, ρ_paste
