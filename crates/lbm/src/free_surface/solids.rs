@@ -111,22 +111,11 @@ pub fn uncover<L: Lattice>(s: &mut FreeSurface<L>, x: usize) -> Exchanged {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::domain::{Domain, Face};
     use crate::lattice::D3Q19;
 
     fn pool(n: [usize; 3], level: usize) -> FreeSurface<D3Q19> {
-        let wall = Face::Wall { velocity: [0.0; 3] };
-        let dom = Domain::new(
-            n,
-            [
-                Face::Periodic,
-                Face::Periodic,
-                wall,
-                wall,
-                Face::Periodic,
-                Face::Periodic,
-            ],
-        );
+        // walls below and above, periodic in x and z
+        let dom = crate::cases::poiseuille::channel_box(n);
         FreeSurface::<D3Q19>::new(dom, |p| {
             (if p[1] < level { 1.0 } else { 0.0 }, 1.0, [0.01, 0.0, 0.0])
         })
