@@ -113,6 +113,8 @@ pub struct SurfaceGrains {
     owned: Vec<u32>,
     next: Vec<u32>,
     claimed: Vec<u32>,
+    /// Surface velocity (lattice units) of each claimed node, in `claimed`'s order.
+    claimed_u: Vec<[f64; 3]>,
     /// Per sphere: force and moment of the last exchange (N, N m).
     load: Vec<(Vec3, Vec3)>,
     /// Hand the momentum of covered and uncovered liquid to the grains (module doc).
@@ -177,6 +179,7 @@ impl SurfaceGrains {
             owned: Vec::new(),
             next: vec![NO_GRAIN; n],
             claimed: Vec::new(),
+            claimed_u: Vec::new(),
             load: Vec::new(),
             conserve_momentum: true,
             driven: None,
@@ -369,12 +372,15 @@ impl SurfaceGrains {
         }
         let mut claimed = std::mem::take(&mut self.claimed);
         let mut next = std::mem::take(&mut self.next);
+        let mut claimed_u = std::mem::take(&mut self.claimed_u);
         claimed.clear();
+        claimed_u.clear();
         for k in 0..ns {
-            self.for_nodes_of(sys, k, |x, _| {
+            self.for_nodes_of(sys, k, |x, d| {
                 if next[x] == NO_GRAIN && self.liquid.cell[x] != WALL {
                     next[x] = k as u32;
                     claimed.push(x as u32);
+                    claimed_u.push(self.surface_velocity(sys, k, d));
                 }
             });
         }
@@ -406,16 +412,11 @@ impl SurfaceGrains {
         std::mem::swap(&mut self.owned, &mut claimed);
         self.next = next;
         self.claimed = claimed;
-        // surface velocities (Eq. 20) of every grain node
-        for k in 0..ns {
-            let mut nodes = Vec::new();
-            self.for_nodes_of(sys, k, |x, d| nodes.push((x, d)));
-            for (x, d) in nodes {
-                if self.owner[x] == k as u32 {
-                    self.liquid.solid_u[x] = self.surface_velocity(sys, k, d);
-                }
-            }
+        // surface velocities (Eq. 20) of every grain node, found when it was claimed
+        for (&x, &u) in self.owned.iter().zip(&claimed_u) {
+            self.liquid.solid_u[x as usize] = u;
         }
+        self.claimed_u = claimed_u;
         Ok(impulse)
     }
 
