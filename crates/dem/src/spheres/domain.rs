@@ -136,7 +136,7 @@ impl Domain3 {
 
     /// Minimum-image separation `d` = x_j − x_i and the velocity to add to v_j for the image
     /// used (Lees-Edwards: ∓γ̇ L_y x̂ when the image is one box down or up; zero otherwise).
-    #[inline]
+    #[inline(always)]
     pub fn min_image_moving(&self, d: Vec3) -> (Vec3, Vec3) {
         let Some(le) = self.shear else {
             return (self.min_image(d), Vec3::ZERO);
@@ -151,8 +151,20 @@ impl Domain3 {
             d.x += k * le.offset;
             dv.x = k * le.rate * l.y;
         }
-        // After the offset |d.x| < 2 L_x.
-        d.x -= l.x * (d.x / l.x).round();
+        // After the offset |d.x| < 2 L_x: at most two shifts, each exact (Sterbenz), so this
+        // is d.x − L_x round(d.x/L_x) without the division or libm's `round`.
+        let half = 0.5 * l.x;
+        if d.x >= half {
+            d.x -= l.x;
+            if d.x >= half {
+                d.x -= l.x;
+            }
+        } else if d.x <= -half {
+            d.x += l.x;
+            if d.x <= -half {
+                d.x += l.x;
+            }
+        }
         if self.periodic[2] && d.z.abs() > 0.5 * l.z {
             d.z -= l.z.copysign(d.z);
         }

@@ -7,7 +7,9 @@
 //!
 //! Parallel where the time goes: the pair laws run on rayon's threads (each pair reads the
 //! spheres and writes only its own history), and their forces are then summed serially in list
-//! order, so results do not depend on the thread count (everything else is serial).
+//! order, so results do not depend on the thread count; the kicks and the per-sphere checks run
+//! on the threads too (each sphere on its own). Walls, gravity, clumps and the list's rebuild
+//! bookkeeping are serial.
 //! Determinism: the pair list is sorted (i < j), every pair beyond the law's range is skipped
 //! (adds nothing) and wall contacts follow in wall order, so each sphere's force is summed in an
 //! order fixed by the set of interactions alone; and the list's reference positions live in the
@@ -62,8 +64,10 @@ pub struct SphereStepper<L: SphereLaw> {
     records: Vec<ContactForce>,
     /// Whether force evaluations fill `records` ([`Self::record_contacts`]; off by default).
     record: bool,
-    /// The pair pass's per-pair results (scratch, list order).
+    /// The pair pass's per-pair results when recording (scratch, list order; empty otherwise).
     hits: Vec<Option<PairHit>>,
+    /// The pair pass's per-pair sums when not recording (scratch, list order).
+    sums: Vec<Option<PairSum>>,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
@@ -78,6 +82,7 @@ impl<L: SphereLaw> Default for SphereStepper<L> {
             records: Vec::new(),
             record: false,
             hits: Vec::new(),
+            sums: Vec::new(),
             rebuilds: 0,
         }
     }
@@ -201,14 +206,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         let n = sys.spheres.len();
         // Opening half kick and drift: mobile spheres (frozen ones stay), then clumps (members
         // placed on them).
-        for k in 0..n {
-            if sys.is_mobile(k) {
-                let s = &mut sys.spheres;
-                s.vel[k] += s.force[k] * (h / s.mass[k]);
-                s.omega[k] += s.torque[k] * (h / s.inertia[k]);
-                (s.pos[k], s.vel[k]) = dom.wrap_moving(s.pos[k] + s.vel[k] * dt, s.vel[k]);
-            }
-        }
+        kick(&mut sys.spheres, h, Some((dt, &dom)));
         let c = &mut sys.clumps;
         for k in 0..c.len() {
             c.vel[k] += c.force[k] * (h / c.mass[k]);
@@ -229,13 +227,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         }
         self.forces(p, law, sys, hook);
         // Closing half kick.
-        for k in 0..n {
-            if sys.is_mobile(k) {
-                let s = &mut sys.spheres;
-                s.vel[k] += s.force[k] * (h / s.mass[k]);
-                s.omega[k] += s.torque[k] * (h / s.inertia[k]);
-            }
-        }
+        kick(&mut sys.spheres, h, None);
         let c = &mut sys.clumps;
         for k in 0..c.len() {
             c.vel[k] += c.force[k] * (h / c.mass[k]);
@@ -244,8 +236,10 @@ impl<L: SphereLaw> SphereStepper<L> {
         place_members(sys, false);
         sys.step += 1;
         let s = &sys.spheres;
-        if let Some(k) =
-            (0..n).find(|&k| !(s.pos[k].is_finite() && s.vel[k].is_finite() && s.omega[k].is_finite()))
+        if let Some(k) = (0..n)
+            .into_par_iter()
+            .with_min_len(SPHERE_CHUNK)
+            .position_first(|k| !(s.pos[k].is_finite() && s.vel[k].is_finite() && s.omega[k].is_finite()))
         {
             self.records.clear();
             return Err(SphereError::NonFinite {
@@ -277,8 +271,9 @@ impl<L: SphereLaw> SphereStepper<L> {
             let half = 0.5 * (skin - slide);
             let lim = half * half;
             s.pos
-                .iter()
+                .par_iter()
                 .zip(&c.list_ref)
+                .with_min_len(SPHERE_CHUNK)
                 .all(|(&p, &q)| dom.min_image(p - q).norm2() <= lim)
         };
         if !fresh {
@@ -331,14 +326,31 @@ impl<L: SphereLaw> SphereStepper<L> {
         // The laws in parallel (each pair reads the spheres and writes only its own history),
         // then the sums in list order, serially: the same additions in the same order whatever
         // the thread count, so the bits do not depend on it.
-        {
-            let (s, pairs, dt) = (&*s, &c.pairs, p.dt);
-            pairs
-                .par_iter()
-                .zip(hist.par_iter_mut())
-                .with_min_len(PAIR_CHUNK)
-                .map(|(pair, h)| pair_response(law, &dom, s, cl, dt, *pair, h))
-                .collect_into_vec(&mut self.hits);
+        if !self.record {
+            // No stale records' hits summed below.
+            self.hits.clear();
+            // Only what the sums need (the force on i, the torques on i and j), a third of a
+            // full hit: the pass writes and the sums read this array once per step.
+            pair_pass(law, &dom, s, cl, p.dt, &c.pairs, hist, &mut self.sums, |hit| {
+                let tq = hit.nrm.cross(hit.out.f);
+                PairSum {
+                    f: hit.out.f,
+                    ti: tq * hit.ai + hit.out.torque_i,
+                    tj: tq * hit.aj + hit.out.torque_j,
+                }
+            });
+            for (pair, sum) in c.pairs.iter().zip(&self.sums) {
+                let Some(PairSum { f, ti, tj }) = *sum else {
+                    continue;
+                };
+                let (i, j) = (pair[0] as usize, pair[1] as usize);
+                s.force[i] += f;
+                s.force[j] -= f;
+                s.torque[i] += ti;
+                s.torque[j] += tj;
+            }
+        } else {
+            pair_pass(law, &dom, s, cl, p.dt, &c.pairs, hist, &mut self.hits, |hit| hit);
         }
         for (pair, hit) in c.pairs.iter().zip(&self.hits) {
             let Some(PairHit { out, nrm, ai, aj, d }) = *hit else {
@@ -431,6 +443,72 @@ impl<L: SphereLaw> SphereStepper<L> {
 /// amortises rayon's hand-off).
 const PAIR_CHUNK: usize = 512;
 
+/// Spheres per parallel task of the per-sphere passes (kicks, list check, finiteness).
+const SPHERE_CHUNK: usize = 4096;
+
+/// A half kick of the mobile spheres (v += F h/m, ω += T h/I) and, with `drift = Some((dt,
+/// domain))`, the drift x += v dt wrapped into the box. Each sphere on its own: parallel, and
+/// the same bits on any thread count.
+fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>) {
+    let (owner, frozen, mass, inertia, force, torque) =
+        (&s.owner, &s.frozen, &s.mass, &s.inertia, &s.force, &s.torque);
+    s.pos
+        .par_iter_mut()
+        .zip(s.vel.par_iter_mut())
+        .zip(s.omega.par_iter_mut())
+        .enumerate()
+        .with_min_len(SPHERE_CHUNK)
+        .for_each(|(k, ((x, v), w))| {
+            // Mobile: free (no clump) and not frozen (as `SphereSystem::is_mobile`).
+            if owner.get(k).is_some_and(|&o| o != FREE) || frozen.get(k).is_some_and(|&f| f) {
+                return;
+            }
+            *v += force[k] * (h / mass[k]);
+            *w += torque[k] * (h / inertia[k]);
+            if let Some((dt, dom)) = drift {
+                (*x, *v) = dom.wrap_moving(*x + *v * dt, *v);
+            }
+        });
+}
+
+/// What the sums need of one pair when no records are kept.
+#[derive(Clone, Copy, Debug)]
+struct PairSum {
+    /// Force on i (−f on j).
+    f: Vec3,
+    /// Torque on i and on j.
+    ti: Vec3,
+    tj: Vec3,
+}
+
+/// The pair laws of `pairs` on rayon's threads, in chunks (each pair reads the spheres and
+/// writes only its own history), each hit mapped by `keep` into `out` (list order; `None`
+/// beyond the law's range).
+#[allow(clippy::too_many_arguments)]
+fn pair_pass<L: SphereLaw, T: Send>(
+    law: &L,
+    dom: &super::domain::Domain3,
+    s: &Spheres,
+    cl: &Clumps,
+    dt: f64,
+    pairs: &[[u32; 2]],
+    hist: &mut [L::History],
+    out: &mut Vec<Option<T>>,
+    keep: impl Fn(PairHit) -> T + Sync,
+) {
+    out.clear();
+    out.resize_with(pairs.len(), || None);
+    pairs
+        .par_chunks(PAIR_CHUNK)
+        .zip(hist.par_chunks_mut(PAIR_CHUNK))
+        .zip(out.par_chunks_mut(PAIR_CHUNK))
+        .for_each(|((pairs, hist), out)| {
+            for ((pair, h), o) in pairs.iter().zip(hist).zip(out) {
+                *o = pair_response(law, dom, s, cl, dt, *pair, h).map(&keep);
+            }
+        });
+}
+
 /// What one pair's law returned, with what the sums need: the unit normal, the arms to the
 /// contact point and the branch vector.
 #[derive(Clone, Copy, Debug)]
@@ -443,7 +521,9 @@ struct PairHit {
 }
 
 /// The law of the pair `pair` (i < j) at the spheres' present state, updating its history; None
-/// (and a fresh history) beyond the law's range.
+/// (and a fresh history) beyond the law's range. Inlined into the pair pass's chunk loop, so
+/// that what the law computes once per call (its effective constants) leaves the loop.
+#[inline(always)]
 fn pair_response<L: SphereLaw>(
     law: &L,
     dom: &super::domain::Domain3,

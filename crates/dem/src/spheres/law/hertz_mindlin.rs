@@ -201,7 +201,7 @@ impl SphereLaw for HertzMindlinSpring {
     /// The tangential spring ξ (m).
     type History = Vec3;
 
-    #[inline]
+    #[inline(always)]
     fn force(&self, c: &Interaction, xi: &mut Vec3) -> Response {
         let k = if c.wall {
             self.wall_coeffs()
@@ -235,7 +235,7 @@ impl SphereLaw for HertzMindlinSpring {
 
 /// The contact force on body i (the reaction acts on j); 0 when not overlapping (the spring
 /// zeroed). `xi` is the tangential spring of the contact, updated in place.
-#[inline]
+#[inline(always)]
 pub fn hertz_mindlin_force(c: &Coeffs, k: &Interaction, xi: &mut Vec3) -> Vec3 {
     if k.delta <= 0.0 {
         *xi = Vec3::ZERO;

@@ -141,7 +141,7 @@ pub(crate) fn check_fraction(name: &'static str, value: f64) -> Result<(), Spher
 /// where the incremental form would not. When |F_t| > μ max(F_n, 0) the force is scaled onto
 /// the cone and the spring reset to ξ = −(F_t + c_t v_t)/k_t, so it holds exactly the force that
 /// slides. Returns F_t.
-#[inline]
+#[inline(always)]
 pub(crate) fn tangential_spring(
     xi: &mut Vec3,
     n: Vec3,
