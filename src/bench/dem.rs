@@ -74,7 +74,6 @@ fn peer(n_side: usize, np: usize, steps: usize) -> Result<(f64, f64)> {
         .args([n_side.to_string(), np.to_string(), steps.to_string()])
         .output()
         .with_context(|| format!("cannot run {}", script.display()))?;
-    let text = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
         bail!(
             "{} failed: {}",
@@ -82,17 +81,25 @@ fn peer(n_side: usize, np: usize, steps: usize) -> Result<(f64, f64)> {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    // "Loop time of T on P procs for S steps with N atoms", preceded by the last thermo line
-    // "step atoms ke phi z press pxy".
+    lammps_loop_rate(&String::from_utf8_lossy(&out.stdout))
+}
+
+/// (particle-steps/s, contacts per particle) from a LAMMPS run's output: the "Loop time of T on
+/// P procs for S steps with N atoms" line and, before it, the last thermo line, whose fifth
+/// column is the mean contacts per particle (both peer decks print "step atoms ke phi z ...").
+pub(super) fn lammps_loop_rate(text: &str) -> Result<(f64, f64)> {
     let lines: Vec<&str> = text.lines().collect();
     let at = lines
         .iter()
         .rposition(|l| l.starts_with("Loop time"))
         .context("no 'Loop time' line from LAMMPS")?;
     let w: Vec<&str> = lines[at].split_whitespace().collect();
-    let t: f64 = w[3].parse()?;
-    let s: f64 = w[8].parse()?;
-    let n: f64 = w[11].parse()?;
+    let field = |k: usize| -> Result<f64> {
+        w.get(k)
+            .and_then(|v| v.parse().ok())
+            .with_context(|| format!("unreadable LAMMPS line '{}'", lines[at]))
+    };
+    let (t, s, n) = (field(3)?, field(8)?, field(11)?);
     let z = at
         .checked_sub(1)
         .and_then(|k| lines[k].split_whitespace().nth(4))
@@ -102,7 +109,7 @@ fn peer(n_side: usize, np: usize, steps: usize) -> Result<(f64, f64)> {
 }
 
 /// The 1-minute load average (the machine is shared: figures taken under load are depressed).
-fn load_average() -> Option<f64> {
+pub(super) fn load_average() -> Option<f64> {
     std::fs::read_to_string("/proc/loadavg")
         .ok()?
         .split_whitespace()
@@ -177,4 +184,20 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_lammps_loop_line_gives_particle_steps_per_second_and_contacts() {
+        let out = "   1200   10648   1.2e-09   0.62   5.01   33.1   0.2\n\
+                   Loop time of 1.8436 on 1 procs for 1000 steps with 10648 atoms\n";
+        let (rate, z) = lammps_loop_rate(out).unwrap();
+        assert!((rate - 10648.0 * 1000.0 / 1.8436).abs() < 1e-6 * rate);
+        assert_eq!(z, 5.01);
+        let err = lammps_loop_rate("ERROR: Unknown pair style\n").unwrap_err();
+        assert!(err.to_string().contains("Loop time"), "{err}");
+    }
 }

@@ -5,6 +5,7 @@
 pub mod bandwidth;
 pub mod coupled;
 pub mod dem;
+pub mod dem3d;
 pub mod free_surface;
 pub mod grains;
 pub mod lbm;
@@ -26,6 +27,8 @@ pub enum Which {
     Lbm,
     /// DEM particle-steps per second.
     Dem,
+    /// 3D sphere DEM particle-steps per second (dense frictional Hertz-Mindlin spheres).
+    Dem3d,
     /// Two-circle grain fitting rate.
     Grains,
     /// Coupled LBM-DEM steps per second on a shear-cell-sized case.
@@ -88,6 +91,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         Which::Radiograph => radiograph::run(a),
         Which::Lbm => lbm::run(a),
         Which::Dem => dem::run(a),
+        Which::Dem3d => dem3d::run(a),
         Which::Grains => grains::run(a),
         Which::Coupled => coupled::run(a),
         Which::Su2020 => su2020::run(a),
