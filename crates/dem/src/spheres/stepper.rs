@@ -203,7 +203,6 @@ impl<L: SphereLaw> SphereStepper<L> {
         // The Lees-Edwards images move first: positions at t + dt wrap with the offset of t + dt.
         sys.domain.advance(dt);
         let dom = sys.domain;
-        let n = sys.spheres.len();
         // Opening half kick and drift: mobile spheres (frozen ones stay), then clumps (members
         // placed on them).
         kick(&mut sys.spheres, h, Some((dt, &dom)));
@@ -235,12 +234,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         }
         place_members(sys, false);
         sys.step += 1;
-        let s = &sys.spheres;
-        if let Some(k) = (0..n)
-            .into_par_iter()
-            .with_min_len(SPHERE_CHUNK)
-            .position_first(|k| !(s.pos[k].is_finite() && s.vel[k].is_finite() && s.omega[k].is_finite()))
-        {
+        if let Some(k) = first_non_finite(&sys.spheres) {
             self.records.clear();
             return Err(SphereError::NonFinite {
                 sphere: k,
@@ -270,11 +264,16 @@ impl<L: SphereLaw> SphereStepper<L> {
         let fresh = c.list_ref.len() == n && c.hist.len() == c.pairs.len() && slide <= skin && {
             let half = 0.5 * (skin - slide);
             let lim = half * half;
-            s.pos
-                .par_iter()
-                .zip(&c.list_ref)
-                .with_min_len(SPHERE_CHUNK)
-                .all(|(&p, &q)| dom.min_image(p - q).norm2() <= lim)
+            let near = |(&p, &q): (&Vec3, &Vec3)| dom.min_image(p - q).norm2() <= lim;
+            if n < PARALLEL_SPHERES {
+                s.pos.iter().zip(&c.list_ref).all(near)
+            } else {
+                s.pos
+                    .par_iter()
+                    .zip(&c.list_ref)
+                    .with_min_len(SPHERE_CHUNK)
+                    .all(near)
+            }
         };
         if !fresh {
             self.cells.build_pairs(
@@ -446,29 +445,69 @@ const PAIR_CHUNK: usize = 512;
 /// Spheres per parallel task of the per-sphere passes (kicks, list check, finiteness).
 const SPHERE_CHUNK: usize = 4096;
 
+/// Sphere count below which the per-sphere passes run on the calling thread: a rayon hand-off
+/// costs more than such a pass (the reduced extruder, ~2,600 spheres at 0.2 ms a step, ran 1.2
+/// times slower with its four per-sphere passes handed to the pool).
+const PARALLEL_SPHERES: usize = 2 * SPHERE_CHUNK;
+
 /// A half kick of the mobile spheres (v += F h/m, ω += T h/I) and, with `drift = Some((dt,
-/// domain))`, the drift x += v dt wrapped into the box. Each sphere on its own: parallel, and
-/// the same bits on any thread count.
+/// domain))`, the drift x += v dt wrapped into the box. Each sphere on its own: parallel for
+/// large systems, and the same bits on any thread count.
 fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>) {
-    let (owner, frozen, mass, inertia, force, torque) =
-        (&s.owner, &s.frozen, &s.mass, &s.inertia, &s.force, &s.torque);
-    s.pos
-        .par_iter_mut()
-        .zip(s.vel.par_iter_mut())
-        .zip(s.omega.par_iter_mut())
-        .enumerate()
-        .with_min_len(SPHERE_CHUNK)
-        .for_each(|(k, ((x, v), w))| {
-            // Mobile: free (no clump) and not frozen (as `SphereSystem::is_mobile`).
-            if owner.get(k).is_some_and(|&o| o != FREE) || frozen.get(k).is_some_and(|&f| f) {
-                return;
-            }
-            *v += force[k] * (h / mass[k]);
-            *w += torque[k] * (h / inertia[k]);
-            if let Some((dt, dom)) = drift {
-                (*x, *v) = dom.wrap_moving(*x + *v * dt, *v);
-            }
-        });
+    let Spheres {
+        pos,
+        vel,
+        omega,
+        force,
+        torque,
+        mass,
+        inertia,
+        owner,
+        frozen,
+        ..
+    } = s;
+    let one = |k: usize, x: &mut Vec3, v: &mut Vec3, w: &mut Vec3| {
+        // Mobile: free (no clump) and not frozen (as `SphereSystem::is_mobile`, which takes the
+        // whole system).
+        if owner.get(k).is_some_and(|&o| o != FREE) || frozen.get(k).is_some_and(|&f| f) {
+            return;
+        }
+        *v += force[k] * (h / mass[k]);
+        *w += torque[k] * (h / inertia[k]);
+        if let Some((dt, dom)) = drift {
+            (*x, *v) = dom.wrap_moving(*x + *v * dt, *v);
+        }
+    };
+    if pos.len() < PARALLEL_SPHERES {
+        for (k, ((x, v), w)) in pos
+            .iter_mut()
+            .zip(vel.iter_mut())
+            .zip(omega.iter_mut())
+            .enumerate()
+        {
+            one(k, x, v, w);
+        }
+    } else {
+        pos.par_iter_mut()
+            .zip(vel.par_iter_mut())
+            .zip(omega.par_iter_mut())
+            .enumerate()
+            .with_min_len(SPHERE_CHUNK)
+            .for_each(|(k, ((x, v), w))| one(k, x, v, w));
+    }
+}
+
+/// The first sphere whose position, velocity or spin is not finite.
+fn first_non_finite(s: &Spheres) -> Option<usize> {
+    let bad = |k: usize| !(s.pos[k].is_finite() && s.vel[k].is_finite() && s.omega[k].is_finite());
+    if s.len() < PARALLEL_SPHERES {
+        (0..s.len()).find(|&k| bad(k))
+    } else {
+        (0..s.len())
+            .into_par_iter()
+            .with_min_len(SPHERE_CHUNK)
+            .position_first(bad)
+    }
 }
 
 /// What the sums need of one pair when no records are kept.
@@ -481,9 +520,9 @@ struct PairSum {
     tj: Vec3,
 }
 
-/// The pair laws of `pairs` on rayon's threads, in chunks (each pair reads the spheres and
-/// writes only its own history), each hit mapped by `keep` into `out` (list order; `None`
-/// beyond the law's range).
+/// The pair laws of `pairs` on rayon's threads, in tasks of at least `PAIR_CHUNK` pairs (each
+/// pair reads the spheres and writes only its own history), each hit mapped by `keep` into
+/// `out` (list order; `None` beyond the law's range).
 #[allow(clippy::too_many_arguments)]
 fn pair_pass<L: SphereLaw, T: Send>(
     law: &L,
@@ -496,17 +535,12 @@ fn pair_pass<L: SphereLaw, T: Send>(
     out: &mut Vec<Option<T>>,
     keep: impl Fn(PairHit) -> T + Sync,
 ) {
-    out.clear();
-    out.resize_with(pairs.len(), || None);
     pairs
-        .par_chunks(PAIR_CHUNK)
-        .zip(hist.par_chunks_mut(PAIR_CHUNK))
-        .zip(out.par_chunks_mut(PAIR_CHUNK))
-        .for_each(|((pairs, hist), out)| {
-            for ((pair, h), o) in pairs.iter().zip(hist).zip(out) {
-                *o = pair_response(law, dom, s, cl, dt, *pair, h).map(&keep);
-            }
-        });
+        .par_iter()
+        .zip(hist.par_iter_mut())
+        .with_min_len(PAIR_CHUNK)
+        .map(|(pair, h)| pair_response(law, dom, s, cl, dt, *pair, h).map(&keep))
+        .collect_into_vec(out);
 }
 
 /// What one pair's law returned, with what the sums need: the unit normal, the arms to the
@@ -522,7 +556,7 @@ struct PairHit {
 
 /// The law of the pair `pair` (i < j) at the spheres' present state, updating its history; None
 /// (and a fresh history) beyond the law's range. Inlined, with the law and the minimum image,
-/// into the pair pass's chunk loop (1.13x on `bench dem3d`); the law's per-call constants, such
+/// into the pair pass's loop (1.13x on `bench dem3d`); the law's per-call constants, such
 /// as the Hertz-Mindlin restitution's β and its `ln`, are still computed per pair.
 #[inline(always)]
 fn pair_response<L: SphereLaw>(
