@@ -7,8 +7,8 @@
 //! The first `--peer` run prepares and caches the LAMMPS packings in out/peer-lammps/ (the
 //! 100,000-disk one takes 45,000 steps: ~20-40 min on a shared machine).
 
-use super::{BenchArgs, median};
-use anyhow::{Context, Result, bail};
+use super::{BenchArgs, lammps};
+use anyhow::Result;
 use lbdem_dem::contact::LinearSpringDashpot;
 use lbdem_dem::{Damping, StepParams, Stepper, System, Vec2, generate};
 use std::path::Path;
@@ -68,54 +68,10 @@ fn timed(s0: &System, steps: usize, threads: usize) -> Result<(f64, f64)> {
 
 /// LAMMPS rate (particle-steps/s) and contacts per disk from scripts/peer-lammps.sh.
 fn peer(n_side: usize, np: usize, steps: usize) -> Result<(f64, f64)> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/peer-lammps.sh");
-    let out = std::process::Command::new("bash")
-        .arg(&script)
-        .args([n_side.to_string(), np.to_string(), steps.to_string()])
-        .output()
-        .with_context(|| format!("cannot run {}", script.display()))?;
-    if !out.status.success() {
-        bail!(
-            "{} failed: {}",
-            script.display(),
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-    lammps_loop_rate(&String::from_utf8_lossy(&out.stdout))
-}
-
-/// (particle-steps/s, contacts per particle) from a LAMMPS run's output: the "Loop time of T on
-/// P procs for S steps with N atoms" line and, before it, the last thermo line, whose fifth
-/// column is the mean contacts per particle (both peer decks print "step atoms ke phi z ...").
-pub(super) fn lammps_loop_rate(text: &str) -> Result<(f64, f64)> {
-    let lines: Vec<&str> = text.lines().collect();
-    let at = lines
-        .iter()
-        .rposition(|l| l.starts_with("Loop time"))
-        .context("no 'Loop time' line from LAMMPS")?;
-    let w: Vec<&str> = lines[at].split_whitespace().collect();
-    let field = |k: usize| -> Result<f64> {
-        w.get(k)
-            .and_then(|v| v.parse().ok())
-            .with_context(|| format!("unreadable LAMMPS line '{}'", lines[at]))
-    };
-    let (t, s, n) = (field(3)?, field(8)?, field(11)?);
-    let z = at
-        .checked_sub(1)
-        .and_then(|k| lines[k].split_whitespace().nth(4))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(f64::NAN);
-    Ok((n * s / t, z))
-}
-
-/// The 1-minute load average (the machine is shared: figures taken under load are depressed).
-pub(super) fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
+    lammps::run_script(
+        "peer-lammps.sh",
+        &[n_side.to_string(), np.to_string(), steps.to_string()],
+    )
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -128,13 +84,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         cases.push(("100k", 316, generate::tile(&s10, 5, 2)?, 400));
     }
     let mut rows = Vec::new();
-    println!(
-        "| case | N | threads | lbdem M p-steps/s (median of {reps}) | z | LAMMPS M p-steps/s | LAMMPS z | ratio | load avg |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    lammps::header(reps);
     for (name, n_side, s, steps) in &cases {
         for threads in [1usize, 2] {
-            // lbdem and LAMMPS alternate rep by rep, so a change of machine load hits both.
             let lsteps = if *n_side > 100 { 1000 } else { 4000 };
             if a.peer
                 && !Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -143,61 +95,17 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             {
                 eprintln!("bench dem: preparing the LAMMPS packing for N_SIDE {n_side} once (slow)");
             }
-            let (mut rates, mut pr) = (Vec::new(), Vec::new());
-            let (mut z, mut zl) = (0.0, f64::NAN);
-            for _ in 0..reps {
-                let (r, zz) = timed(s, *steps, threads)?;
-                rates.push(r);
-                z = zz;
-                if a.peer {
-                    let (r, zz) = peer(*n_side, threads, lsteps)?;
-                    pr.push(r);
-                    zl = zz;
-                }
-            }
-            let ours = median(&rates);
-            let (theirs, zl, ratio) = if a.peer {
-                let t = median(&pr);
-                (Some(t), Some(zl), Some(ours / t))
-            } else {
-                (None, None, None)
-            };
-            println!(
-                "| {name} | {} | {threads} | {:.2} | {z:.2} | {} | {} | {} | {} |",
+            rows.push(lammps::row(
+                name,
                 s.bodies.len(),
-                ours / 1e6,
-                theirs.map_or("-".into(), |t| format!("{:.2}", t / 1e6)),
-                zl.map_or("-".into(), |z| format!("{z:.2}")),
-                ratio.map_or("-".into(), |r| format!("{r:.2}")),
-                load_average().map_or("-".into(), |l| format!("{l:.1}"))
-            );
-            rows.push(serde_json::json!({
-                "case": name, "n": s.bodies.len(), "threads": threads, "rate": ours, "rates": rates,
-                "contacts_per_particle": z, "lammps_rate": theirs, "lammps_rates": pr, "lammps_contacts_per_particle": zl,
-                "ratio_to_lammps": ratio, "load_average": load_average(),
-            }));
+                threads,
+                reps,
+                a.peer,
+                2,
+                || timed(s, *steps, threads),
+                || peer(*n_side, threads, lsteps),
+            )?);
         }
     }
-    if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&serde_json::json!({ "bench": "dem", "rows": rows }))?;
-        lbdem_core::atomic::write_atomic(path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_lammps_loop_line_gives_particle_steps_per_second_and_contacts() {
-        let out = "   1200   10648   1.2e-09   0.62   5.01   33.1   0.2\n\
-                   Loop time of 1.8436 on 1 procs for 1000 steps with 10648 atoms\n";
-        let (rate, z) = lammps_loop_rate(out).unwrap();
-        assert!((rate - 10648.0 * 1000.0 / 1.8436).abs() < 1e-6 * rate);
-        assert_eq!(z, 5.01);
-        let err = lammps_loop_rate("ERROR: Unknown pair style\n").unwrap_err();
-        assert!(err.to_string().contains("Loop time"), "{err}");
-    }
+    lammps::write_json(a.json.as_ref(), "dem", rows)
 }

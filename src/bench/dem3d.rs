@@ -18,9 +18,8 @@
 //! ours is β's (both from e = 0.5), so the dissipation differs slightly; the contacts per
 //! sphere of both runs are printed to show they work on the same network.
 
-use super::{BenchArgs, median};
-use crate::bench::dem::{lammps_loop_rate, load_average};
-use anyhow::{Context, Result, bail};
+use super::{BenchArgs, lammps};
+use anyhow::{Context, Result};
 use lbdem_dem::generate::rng;
 use lbdem_dem::spheres::{
     Domain3, Elastic, HertzMindlinSpring, SphereStepParams, SphereStepper, SphereSystem, Surface,
@@ -288,26 +287,16 @@ fn write_data(sys: &SphereSystem, path: &Path) -> Result<()> {
 
 /// LAMMPS on the data file: (particle-steps/s, contacts per sphere).
 fn peer(data: &Path, np: usize, steps: usize, dt: f64) -> Result<(f64, f64)> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/peer-lammps-3d.sh");
-    let out = std::process::Command::new("bash")
-        .arg(&script)
-        .arg(data)
-        .args([
+    lammps::run_script(
+        "peer-lammps-3d.sh",
+        &[
+            data.display().to_string(),
             np.to_string(),
             steps.to_string(),
             format!("{dt:.17e}"),
             format!("{SHEAR_RATE}"),
-        ])
-        .output()
-        .with_context(|| format!("cannot run {}", script.display()))?;
-    if !out.status.success() {
-        bail!(
-            "{} failed: {}",
-            script.display(),
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-    lammps_loop_rate(&String::from_utf8_lossy(&out.stdout))
+        ],
+    )
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
@@ -336,10 +325,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         packing_fraction(&base),
         bench_dt(&base)?
     );
-    println!(
-        "| case | N | threads | lbdem M p-steps/s (median of {reps}) | z | LAMMPS M p-steps/s | LAMMPS z | ratio | load avg |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    lammps::header(reps);
     let mut rows = Vec::new();
     for (name, s, steps) in &cases {
         let data = dir.join(format!("lmp3d_{name}.data"));
@@ -348,45 +334,19 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         }
         let dt = bench_dt(s)?;
         for threads in [1usize, 2] {
-            let (mut rates, mut pr) = (Vec::new(), Vec::new());
-            let (mut z, mut zl) = (0.0, f64::NAN);
-            // lbdem and LAMMPS alternate rep by rep, so a change of machine load hits both.
-            for _ in 0..reps {
-                let (r, zz) = timed(s, *steps, threads)?;
-                rates.push(r);
-                z = zz;
-                if a.peer {
-                    let (r, zz) = peer(&data, threads, *steps, dt)?;
-                    pr.push(r);
-                    zl = zz;
-                }
-            }
-            let ours = median(&rates);
-            let theirs = a.peer.then(|| median(&pr));
-            let ratio = theirs.map(|t| ours / t);
-            println!(
-                "| {name} | {} | {threads} | {:.3} | {z:.2} | {} | {} | {} | {} |",
+            rows.push(lammps::row(
+                name,
                 s.spheres.len(),
-                ours / 1e6,
-                theirs.map_or("-".into(), |t| format!("{:.3}", t / 1e6)),
-                if a.peer { format!("{zl:.2}") } else { "-".into() },
-                ratio.map_or("-".into(), |r| format!("{r:.2}")),
-                load_average().map_or("-".into(), |l| format!("{l:.1}"))
-            );
-            rows.push(serde_json::json!({
-                "case": name, "n": s.spheres.len(), "threads": threads, "rate": ours, "rates": rates,
-                "contacts_per_sphere": z, "lammps_rate": theirs, "lammps_rates": pr,
-                "lammps_contacts_per_sphere": if a.peer { Some(zl) } else { None },
-                "ratio_to_lammps": ratio, "load_average": load_average(),
-            }));
+                threads,
+                reps,
+                a.peer,
+                3,
+                || timed(s, *steps, threads),
+                || peer(&data, threads, *steps, dt),
+            )?);
         }
     }
-    if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&serde_json::json!({ "bench": "dem3d", "rows": rows }))?;
-        lbdem_core::atomic::write_atomic(path, text.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(())
+    lammps::write_json(a.json.as_ref(), "dem3d", rows)
 }
 
 #[cfg(test)]
@@ -395,8 +355,8 @@ mod tests {
 
     /// The bench's case is what its doc says: grown to φ = 0.62 exactly, with the final
     /// diameters, and jammed (every sphere's network rigid: contacts per sphere above the
-    /// frictional isostatic 4; the 1000-sphere packing measured 5.28 here and in LAMMPS on
-    /// 2026-11-30).
+    /// frictional isostatic 4; `bench dem3d --quick --peer` on this packing measured 5.20 after
+    /// its 300 steps, LAMMPS 5.19, on 2026-11-30).
     #[test]
     fn the_quick_packing_is_jammed_at_its_packing_fraction() {
         let s = packing(10, 1500, 500).unwrap();

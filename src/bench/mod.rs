@@ -8,6 +8,7 @@ pub mod dem;
 pub mod dem3d;
 pub mod free_surface;
 pub mod grains;
+pub mod lammps;
 pub mod lbm;
 pub mod radiograph;
 pub mod resolution;
