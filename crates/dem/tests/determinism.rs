@@ -32,11 +32,7 @@ fn run(s: &mut System, law: &LinearSpringDashpot, p: &StepParams, n: usize) {
 fn identical_for_one_and_two_threads() {
     let (s0, law, p) = packing();
     let go = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             let mut s = s0.clone();
             // Keep shearing a little so contacts slide and the list is rebuilt.
             for _ in 0..4 {
@@ -186,11 +182,7 @@ fn grain_removal_and_addition_change_packing_fraction() {
 fn clumps_with_walls_identical_for_one_and_two_threads() {
     let (s0, law, p) = common::clumps_in_walled_box(30.0, 600, 5);
     let go = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::on_threads(threads, || {
             let mut s = s0.clone();
             run(&mut s, &law, &p, 3000);
             s

@@ -28,11 +28,7 @@ impl<L: ContactLaw<History = History>> ContactLaw for Generic<L> {
 fn sheared<L: ContactLaw>(law: &L, threads: usize) -> System {
     let mut s = generate::bidisperse_lattice(24, 1.0, 1.4, 1.42, 7).unwrap();
     let p = StepParams::new(2.5e-4, 0.1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    common::on_threads(threads, || {
         let mut st = Stepper::new();
         generate::compress_periodic(&mut s, law, &p, 0.8, 1200, &mut st).unwrap();
         for _ in 0..4 {

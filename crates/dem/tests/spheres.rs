@@ -398,11 +398,7 @@ fn a_large_system_gives_the_same_bits_on_one_and_two_threads() {
     assert!(s0.spheres.len() >= 8192);
     let p = params();
     let go = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        crate::common::on_threads(threads, || {
             let mut s = s0.clone();
             run(&mut s, &mut SphereStepper::new(), &p, 60);
             s

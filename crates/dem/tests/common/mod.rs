@@ -66,3 +66,12 @@ pub fn clumps_in_walled_box(side: f64, count: usize, seed: u64) -> (System, Line
     p.gravity = Vec2::new(0.0, -9.81);
     (s, law, p)
 }
+
+/// `f` run on a pool of `threads` threads (the thread-count tests compare its results).
+pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
