@@ -38,8 +38,11 @@ pub struct BinGrid {
     pub size: f64,
     pub nx: usize,
     pub ny: usize,
-    /// Depth in z (m): the periodic slab's.
+    /// Depth in z (m): the periodic slab's, or a monolayer's thickness.
     pub depth: f64,
+    /// A monolayer (every centre in one plane, no force along z): the pressure is the
+    /// in-plane mean (σ_xx + σ_yy)/2, σ_zz being zero there ([`Self::in_plane`]).
+    pub planar: bool,
 }
 
 impl BinGrid {
@@ -68,7 +71,22 @@ impl BinGrid {
             nx: n(x[0], x[1]),
             ny: n(y[0], y[1]),
             depth,
+            planar: false,
         })
+    }
+
+    /// The same grid for a monolayer (2D pressure; see `planar`).
+    pub fn in_plane(self, planar: bool) -> Self {
+        Self { planar, ..self }
+    }
+
+    /// The mean normal stress of components xx, yy, zz: tr/3 in 3D, (xx + yy)/2 in a monolayer.
+    fn mean_normal(&self, s: &[Array2<f64>; 9]) -> Array2<f64> {
+        if self.planar {
+            (&s[0] + &s[4]) / 2.0
+        } else {
+            (&s[0] + &s[4] + &s[8]) / 3.0
+        }
     }
 
     pub fn volume(&self) -> f64 {
@@ -255,16 +273,16 @@ impl CoarseFields {
         s
     }
 
-    /// The kinetic pressure tr σ_kinetic / 3.
+    /// The kinetic pressure tr σ_kinetic / 3 ((xx + yy)/2 in a monolayer).
     pub fn kinetic_pressure(&self) -> Array2<f64> {
-        let s = &self.sigma_kinetic;
-        (&s[0] + &s[4] + &s[8]) / 3.0
+        self.grid.mean_normal(&self.sigma_kinetic)
     }
 
-    /// P = (σ_xx + σ_yy + σ_zz)/3 of the total stress, or of its hydrodynamic part.
+    /// P = (σ_xx + σ_yy + σ_zz)/3 of the total stress, or of its hydrodynamic part; in a
+    /// monolayer (σ_xx + σ_yy)/2, the 2D pressure.
     pub fn pressure(&self, hydro: bool) -> Array2<f64> {
-        let s = if hydro { &self.sigma_hydro } else { &self.sigma };
-        (&s[0] + &s[4] + &s[8]) / 3.0
+        self.grid
+            .mean_normal(if hydro { &self.sigma_hydro } else { &self.sigma })
     }
 
     /// First normal stress difference N_1 = σ_xx − σ_yy.
@@ -543,6 +561,11 @@ mod tests {
         }
         assert!(f.sigma_kinetic[8][[2, 3]].abs() < 1e-12 * want);
         assert!((f.kinetic_pressure()[[2, 3]] - 2.0 * want / 3.0).abs() < 1e-9 * want);
+        // A monolayer's pressure is the in-plane mean: the same motion gives (xx + yy)/2 = want.
+        let mut sums = BinSums::new(g.in_plane(true));
+        sums.add_snapshot(&p).unwrap();
+        let f = sums.fields(rho).unwrap();
+        assert!((f.kinetic_pressure()[[2, 3]] - want).abs() < 1e-9 * want);
     }
 
     #[test]

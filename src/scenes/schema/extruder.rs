@@ -43,8 +43,13 @@ pub struct ExtruderSection {
     pub die_width: f64,
     /// Die length (not in the text of the paper; docs/ness2017.md).
     pub die_length: f64,
-    /// Depth, periodic in z (Ness: 5 d).
+    /// Depth, periodic in z (Ness: 5 d); with `monolayer`, the layer's thickness for volume
+    /// fractions and stresses.
     pub depth: f64,
+    /// One layer of grains in the plane z = depth/2 instead of the periodic slab: the extruder
+    /// as 2D disks with the spheres' laws (default false; docs/ness2017.md, "The monolayer").
+    #[serde(default)]
+    pub monolayer: bool,
     /// Inlet box length from the ram face (Ness's dashed box; about 10 d).
     pub inlet_length: f64,
     /// Wall-grain diameter (default: half the smaller paste diameter, Ness's 0.5 d).
@@ -206,6 +211,7 @@ impl ExtruderSection {
                 wall_jitter: self.wall_jitter,
                 wall_seed: self.wall_seed,
                 outlet_gap: self.outlet_gap,
+                monolayer: self.monolayer,
             },
             paste: Paste {
                 diameters: s.diameters,

@@ -70,6 +70,11 @@ pub const CATALOGUE: &[Simplification] = &[
         edit: short_lubrication,
     },
     Simplification {
+        name: "monolayer",
+        what: "the extruder as one layer of grains (2D disks) instead of the periodic slab, its thickness from the paste (lbdem_dem::spheres::extruder::monolayer_thickness; [extruder] monolayer = true, depth = D)",
+        edit: monolayer,
+    },
+    Simplification {
         name: "coarser-dem-step",
         what: "twice the DEM step, half as many DEM steps per LBM step ([dem] dt x 2)",
         edit: coarser_dem_step,
@@ -232,6 +237,22 @@ fn short_lubrication(t: &mut toml::Table) -> Result<(), String> {
         ));
     }
     s.insert("h_max".into(), Value::Float(SHORT_LUBRICATION));
+    Ok(())
+}
+
+fn monolayer(t: &mut toml::Table) -> Result<(), String> {
+    let d = section(t, "suspension")
+        .and_then(|s| s.get("diameters"))
+        .and_then(Value::as_array)
+        .and_then(|a| Some([a.first()?.as_float()?, a.get(1)?.as_float()?]))
+        .ok_or("the scene has no [suspension] diameters = [d, 1.5 d]")?;
+    let e = section(t, "extruder").ok_or("the scene has no [extruder]")?;
+    if e.get("monolayer").and_then(Value::as_bool) == Some(true) {
+        return Err("[extruder] monolayer is true already".into());
+    }
+    e.insert("monolayer".into(), Value::Boolean(true));
+    let depth = lbdem_dem::spheres::extruder::monolayer_thickness(d);
+    e.insert("depth".into(), Value::Float(depth));
     Ok(())
 }
 
@@ -489,6 +510,29 @@ mod tests {
             let e = apply(&mut t, p).unwrap_err().to_string();
             assert!(e.contains(want), "{e}");
         }
+    }
+
+    /// `monolayer` turns the slab into one layer of the paste's thickness (1.1779 d for d and
+    /// 1.5 d: (2/3)(4.375/3.25) × 0.84/0.64), once, and only on an extruder.
+    #[test]
+    fn monolayer_makes_the_extruder_one_layer_of_the_pastes_thickness() {
+        let p = Path::new("s.toml");
+        let ext = "[scene]\nsimplify = \"monolayer\"\n[extruder]\ndepth = 5.0e-5\n[suspension]\ndiameters = [1.0e-5, 1.5e-5]\n";
+        let mut t = table(ext);
+        apply(&mut t, p).unwrap();
+        assert_eq!(t["extruder"]["monolayer"].as_bool(), Some(true));
+        let depth = t["extruder"]["depth"].as_float().unwrap();
+        let want = 2.0 / 3.0 * (1.0 + 3.375) / (1.0 + 2.25) * 0.84 / 0.64 * 1e-5;
+        assert!(
+            (depth - want).abs() < 1e-18 && (depth - 1.17788e-5).abs() < 1e-10,
+            "{depth}"
+        );
+        let e = apply(&mut t, p).unwrap_err().to_string();
+        assert!(e.contains("monolayer is true already"), "{e}");
+        let mut t = table(COUPLED);
+        t.insert("scene".into(), Value::Table(table(r#"simplify = "monolayer""#)));
+        let e = apply(&mut t, p).unwrap_err().to_string();
+        assert!(e.contains("[suspension] diameters"), "{e}");
     }
 
     #[test]

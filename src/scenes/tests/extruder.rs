@@ -229,7 +229,8 @@ fn the_wall_realisation_sweep_expands_to_thirty_checked_cases() {
 
 /// sweeps/ness2017-fig9.toml (the full Fig. 9 sweep over pipelines/ness2017-case.toml) expands to
 /// 6 cases x 3 forces x 5 wall seeds, each case's simulate stage on its own Table 1 file with its
-/// force and seed, its analysis reading that run; and the reduced flow sweep to its 4 forces.
+/// force and seed, its analysis reading that run; the reduced flow sweep to its 4 forces, and
+/// the slab-against-monolayer sweep to its 24 cases (3 wall realisations).
 /// Nothing is run.
 #[test]
 fn the_fig9_sweeps_expand_to_checked_cases() {
@@ -263,6 +264,28 @@ fn the_fig9_sweeps_expand_to_checked_cases() {
     }
     let s = Sweep::load(&root.join("sweeps/ness2017-reduced-flow.toml")).unwrap();
     assert_eq!(expand(&s, t.path()).unwrap().len(), 4);
+    // The slab against the monolayer: 2 layers x 4 forces x 3 walls, the layer's switch and thickness
+    // reaching the scene.
+    let s = Sweep::load(&root.join("sweeps/ness2017-reduced-layers.toml")).unwrap();
+    let cases = expand(&s, t.path()).unwrap();
+    assert_eq!(cases.len(), 24);
+    for (k, c) in cases.iter().enumerate() {
+        let sim = &c.pipeline.stages[0].params;
+        let l = crate::scenes::schema::load(
+            &root.join(sim["scene"].as_str().unwrap()),
+            sim["overrides"].as_table().unwrap(),
+        )
+        .unwrap();
+        let e = l.scene.extruder.unwrap();
+        let want = [
+            (false, 5.0e-5),
+            (
+                true,
+                lbdem_dem::spheres::extruder::monolayer_thickness([1.0e-5, 1.5e-5]),
+            ),
+        ];
+        assert_eq!((e.monolayer, e.depth), want[k / 12], "case {k}");
+    }
     // The reduced Table 1 cases: each case's friction and stiffness reach its simulate stage.
     let s = Sweep::load(&root.join("sweeps/ness2017-reduced-cases.toml")).unwrap();
     let cases = expand(&s, t.path()).unwrap();
@@ -316,6 +339,56 @@ fn reduced_extruder_reaches_the_mass_balance() {
     assert!(*vd.last().unwrap() > 0.0);
     let imb = column(t.path(), "imbalance");
     assert!(*imb.last().unwrap() <= 0.15);
+}
+
+/// The reduced extruder as one layer of grains (`scenes/ness2017/reduced-monolayer.toml`,
+/// issue 19 item 6) through the runner and the analysis: every sphere of every snapshot has
+/// its centre in the plane z = D/2, grains flow through the die, and the Eq. 7 stress, with the
+/// layer's thickness D as the bins' depth, carries the load the walls take downstream as in the
+/// slab (about 1 s in release).
+#[test]
+fn a_monolayer_extruder_flows_in_its_plane_and_balances_its_wall_loads() {
+    let t = tempfile::tempdir().unwrap();
+    let src = t.path().join("scene");
+    std::fs::create_dir_all(&src).unwrap();
+    std::fs::write(src.join("case-a.toml"), shipped("ness2017/case-a.toml")).unwrap();
+    std::fs::write(src.join("reduced.toml"), shipped("ness2017/reduced.toml")).unwrap();
+    let text = shipped("ness2017/reduced-monolayer.toml")
+        + "\n[run]\ntime = 2.4e-5\n\n[output]\nsnapshots = { every = 1000 }\n";
+    let rec = simulate(&text, t.path(), false).unwrap();
+    assert!(rec.output.summary["engine"]["removed"].as_f64().unwrap() > 20.0);
+    let z0 = 0.5 * lbdem_dem::spheres::extruder::monolayer_thickness([1.0e-5, 1.5e-5]);
+    let mut snaps = 0;
+    for p in walk(&t.path().join("out/snapshots")) {
+        if p.extension().is_some_and(|e| e == "csv") {
+            let z = f64_column(&read_table(&p).unwrap(), "z", &p).unwrap();
+            assert!(z.iter().all(|&z| z == z0), "{} left the plane", p.display());
+            snaps += 1;
+        }
+    }
+    assert!(snaps > 20, "{snaps} snapshots");
+    let stations = "stations_d = [[5.0, 8.0], [9.0, 12.0], [20.0, 23.0], [27.0, 30.0]]";
+    let rec = extrusion(
+        t.path(),
+        "cg",
+        &t.path().join("out"),
+        &format!("from = 1.2e-5\n{stations}"),
+    )
+    .unwrap();
+    let s = &rec.output.summary;
+    let f = |k: &str| s[k].as_f64().unwrap();
+    let balance = f("axial_force_p1") / f("wall_load_x");
+    let p: Vec<f64> = (0..4)
+        .map(|k| s["station_pressure"][k].as_f64().unwrap())
+        .collect();
+    eprintln!(
+        "monolayer: balance {balance:.4}, P {p:?} Pa, static area {} d²",
+        f("static_area")
+    );
+    assert_eq!(s["geometry"]["monolayer"], true);
+    // Measured 2026-11-30: 0.985 (P 767, 677, 5.7, 1.9 kPa); tolerance twice the 1.5 %.
+    assert!((balance - 1.0).abs() < 0.03, "momentum balance {balance}");
+    assert!(p[0] > p[1] && p[1] > p[2] && p[2] > p[3], "{p:?}");
 }
 
 /// Run the `extrusion` stage on `run` with `params` (TOML, `runs` added), into `dir/name`.

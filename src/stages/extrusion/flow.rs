@@ -209,6 +209,7 @@ fn flow(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     }
     for k in [
         "static_grains",
+        "static_area",
         "max_stokes",
         "contact_pressure_share",
         "kinetic_pressure_ratio",
@@ -303,12 +304,10 @@ fn flow(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
     let (v0, v1) = all_v
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
-    for (k, title, file) in
-        MEASURES
-            .iter()
-            .copied()
-            .chain([("static_grains", "Static-zone grains (Fig. 5)", "fig5_static.png")])
-    {
+    for (k, title, file) in MEASURES.iter().copied().chain([
+        ("static_grains", "Static-zone grains (Fig. 5)", "fig5_static.png"),
+        ("static_area", "Static-zone area (Fig. 5)", "fig5_static_area.png"),
+    ]) {
         let data: Vec<(String, Vec<f64>, Vec<f64>)> = by
             .iter()
             .map(|(n, qs)| {
@@ -336,7 +335,7 @@ fn flow(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         // The unit slope through the geometric mean of the points (Ness's dashed line).
         let ys: Vec<f64> = data.iter().flat_map(|d| d.2.iter().copied()).collect();
         let xs: Vec<f64> = data.iter().flat_map(|d| d.1.iter().copied()).collect();
-        let unit = if k != "static_grains" && !ys.is_empty() && v1 > v0 {
+        let unit = if !k.starts_with("static_") && !ys.is_empty() && v1 > v0 {
             let c = (ys.iter().zip(&xs).map(|(y, x)| (y / x).ln()).sum::<f64>() / ys.len() as f64).exp();
             Some(([v0, v1], [c * v0, c * v1]))
         } else {
@@ -356,6 +355,7 @@ fn flow(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         }
         let y_label = match k {
             "static_grains" => "grains in static zones (-)",
+            "static_area" => "static-zone area (d²)",
             _ if k.starts_with("wall") => "τ_w (Pa)",
             _ => "ΔP (Pa)",
         };
@@ -436,7 +436,7 @@ mod tests {
                 let a_json = json!({
                     "label": "x", "die_velocity": v, "dp_entry": entry, "dp_die": die, "dp_barrel": 10.0 * v,
                     "dp_total": entry + die + 10.0 * v, "wall_stress_barrel": v, "wall_stress_die": 2.0 * v,
-                    "static_grains": 5.0 / v, "max_stokes": 0.01, "contact_pressure_share": 0.9,
+                    "static_grains": 5.0 / v, "static_area": 3.0 / v, "max_stokes": 0.01, "contact_pressure_share": 0.9,
                     "geometry": {"barrel_width_d": wb, "die_width_d": wd, "die_length_d": ld},
                 });
                 std::fs::write(dir.join("cg").join(SUMMARY), a_json.to_string()).unwrap();
@@ -468,7 +468,7 @@ mod tests {
         let slope = fits["a"]["log_slope_dp_total"]["slope"].as_f64().unwrap();
         assert!((slope - 1.0).abs() < 1e-12, "{slope}");
         assert!(fits["b"]["log_slope_dp_total"]["slope"].as_f64().unwrap() < 0.99);
-        assert_eq!(out.figures.len(), 7);
+        assert_eq!(out.figures.len(), 8);
         for f in &out.figures {
             assert!(ctx.out_dir.join(&f.path).is_file());
         }

@@ -94,6 +94,8 @@ pub struct Layout {
     pub die_width: f64,
     pub die_length: f64,
     pub depth: f64,
+    /// One layer of grains (2D pressure; `Geometry::monolayer`).
+    pub monolayer: bool,
 }
 
 impl Layout {
@@ -108,6 +110,7 @@ impl Layout {
             die_width: g.die_width / d,
             die_length: g.die_length / d,
             depth: g.depth / d,
+            monolayer: g.monolayer,
         }
     }
 
@@ -196,6 +199,9 @@ pub struct Measured {
     pub wall_stress_die: f64,
     /// Grains in the static zones (Fig. 5), bins below `static_fraction` of the centreline speed.
     pub static_grains: f64,
+    /// The static zones' area (d²: static bins × bin area), comparable between the slab and a
+    /// monolayer where grain counts are not.
+    pub static_area: f64,
     pub static_fraction: f64,
     /// Largest |St| of the four gradients over the channel (Fig. 4: ≪ 1).
     pub max_stokes: f64,
@@ -264,7 +270,8 @@ fn analyse(p: &Params, ctx: &StageContext) -> Result<StageOutput> {
         [-0.5 * lay.barrel_width * d, 0.5 * lay.barrel_width * d],
         p.bin_d * d,
         lay.depth * d,
-    )?;
+    )?
+    .in_plane(lay.monolayer);
     let mut sums = BinSums::new(grid);
     let mut from = Vec::new();
     let chosen: Vec<(usize, PathBuf)> = runs
@@ -410,7 +417,8 @@ fn measure(
         );
     }
     let (zx, zy) = lay.static_window();
-    let (_, static_grains) = f.static_zone(v_centre, p.static_fraction, zx, zy);
+    let (zone, static_grains) = f.static_zone(v_centre, p.static_fraction, zx, zy);
+    let static_area = zone.iter().filter(|&&z| z).count() as f64 * p.bin_d * p.bin_d;
     let scale = runs[0].stokes_scale();
     let grad = f.gradient();
     let max_stokes = grad
@@ -448,6 +456,7 @@ fn measure(
         wall_stress_barrel: series("wall_fx_barrel")? / area(lay.barrel_length),
         wall_stress_die: series("wall_fx_die")? / area(lay.die_length),
         static_grains,
+        static_area,
         static_fraction: p.static_fraction,
         max_stokes,
         contact_pressure_share: pcontact / ptot,
@@ -464,7 +473,7 @@ fn measure(
         station_flux,
         geometry: json!({
             "d": d, "inlet_d": lay.inlet, "barrel_length_d": lay.barrel_length, "barrel_width_d": lay.barrel_width,
-            "die_width_d": lay.die_width, "die_length_d": lay.die_length, "depth_d": lay.depth,
+            "die_width_d": lay.die_width, "die_length_d": lay.die_length, "depth_d": lay.depth, "monolayer": lay.monolayer,
             "density": runs[0].spec.paste.density, "viscosity": runs[0].viscosity,
         }),
     })

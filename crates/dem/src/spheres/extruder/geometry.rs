@@ -1,7 +1,9 @@
 //! The square-entry extruder of Ness et al. (2017), Fig. 1: a barrel of width W_b from the ram
 //! face at x = 0 to the square die entry at x = L_b, a die of width W_d from there to the open
 //! outlet at x = L_b + L_d, flow along +x, y across (centred on the axis), depth D periodic in z
-//! (pseudo-2D). The walls are lines in the x-y plane made of frozen grains of diameter d_w
+//! (pseudo-2D), or a single layer of grains in the plane z = D/2 (`monolayer`: disks that
+//! keep the spheres' contact and lubrication laws; docs/ness2017.md, "The monolayer"). The
+//! walls are lines in the x-y plane made of frozen grains of diameter d_w
 //! ("particles of diameter 0.5d at very high area fraction", Sect. "Geometry and boundary
 //! conditions"), each line a lattice of spacing ≤ s along the line and D/round(D/s) along z; a
 //! wall realisation is a seed that jitters every grain along the line and along z by up to
@@ -42,6 +44,30 @@ pub struct Geometry {
     pub wall_seed: u64,
     /// Grains are removed once their centre is this far past the die's end (m, ≥ 0).
     pub outlet_gap: f64,
+    /// One layer of grains with their centres in the plane z = D/2, z not periodic, one wall
+    /// grain across the depth of each line (issue 19 item 6: the extruder as 2D disks). The
+    /// spheres' laws act in the plane and nothing pushes a grain out of it, so the run stays
+    /// planar to the bit. D is then the layer's thickness for volume fractions and stresses.
+    #[serde(default)]
+    pub monolayer: bool,
+}
+
+/// Jamming (random close packing) volume fraction of bidisperse spheres, and area fraction of
+/// bidisperse disks (O'Hern et al. 2003, Phys. Rev. E 68:011306: 0.64 and 0.84), for
+/// [`monolayer_thickness`].
+pub const JAMMING_3D: f64 = 0.64;
+pub const JAMMING_2D: f64 = 0.84;
+
+/// The thickness D of a monolayer of the 1:1 paste of `diameters` standing in for the slab: a
+/// volume fraction φ of its grains over D is then the area fraction φ × JAMMING_2D/JAMMING_3D,
+/// as far below 2D jamming as φ is below 3D jamming, so the inlet box's φ = 0.5 (Ness) keeps
+/// the paste as loose relative to jamming, and the ram's pressure F × grains / (W_b D) is the
+/// slab's at the same force. D = (mean grain volume / mean disk area) × JAMMING_2D/JAMMING_3D
+/// = (2/3)(⟨d³⟩/⟨d²⟩) × 1.3125: 1.178 d for Ness's d and 1.5 d.
+pub fn monolayer_thickness(diameters: [f64; 2]) -> f64 {
+    let [a, b] = diameters;
+    let (d3, d2) = (a.powi(3) + b.powi(3), a * a + b * b);
+    2.0 / 3.0 * d3 / d2 * (JAMMING_2D / JAMMING_3D)
 }
 
 /// Which wall a frozen grain belongs to (its load is summed per segment).
@@ -200,7 +226,11 @@ impl Geometry {
         // The widest hole between four wall grains, with every neighbour jittered apart.
         let (a, b) = self.spacings(self.barrel_width.min(self.die_length));
         let stretch = 1.0 + 2.0 * self.wall_jitter;
-        let hole = ((a * stretch).powi(2) + (b * stretch).powi(2)).sqrt() - self.wall_diameter;
+        let hole = if self.monolayer {
+            a * stretch - self.wall_diameter
+        } else {
+            ((a * stretch).powi(2) + (b * stretch).powi(2)).sqrt() - self.wall_diameter
+        };
         if hole >= d_min {
             return Err(bad(
                 "wall_spacing",
@@ -212,7 +242,7 @@ impl Geometry {
                 "lower wall_spacing (Ness: touching 0.5 d grains) or wall_jitter",
             ));
         }
-        if self.depth < 2.2 * d_max {
+        if !self.monolayer && self.depth < 2.2 * d_max {
             return Err(bad(
                 "depth",
                 self.depth,
@@ -226,20 +256,34 @@ impl Geometry {
     }
 
     /// The box of the engine: the channel with a margin `m` on the open axes x and y, z
-    /// periodic over the depth.
+    /// periodic over the depth (closed for a monolayer, whose grains never leave z = D/2).
     pub fn domain(&self, margin: f64) -> Result<Domain3, ExtruderError> {
         let hw = 0.5 * self.barrel_width + margin;
         Ok(Domain3::new(
             Vec3::new(-margin, -hw, 0.0),
             Vec3::new(self.outlet_x() + margin, hw, self.depth),
-            [false, false, true],
+            [false, false, !self.monolayer],
         )?)
     }
 
-    /// Spacing along a line of length `len` and along z.
+    /// z of a new grain from a uniform draw `u` in [0, 1): anywhere in the depth, or the
+    /// monolayer's plane.
+    pub fn grain_z(&self, u: f64) -> f64 {
+        if self.monolayer {
+            0.5 * self.depth
+        } else {
+            u * self.depth
+        }
+    }
+
+    /// Spacing along a line of length `len` and along z (one grain across a monolayer).
     fn spacings(&self, len: f64) -> (f64, f64) {
         let along = len / (len / self.wall_spacing).ceil().max(1.0);
-        let nz = (self.depth / self.wall_spacing).round().max(1.0);
+        let nz = if self.monolayer {
+            1.0
+        } else {
+            (self.depth / self.wall_spacing).round().max(1.0)
+        };
         (along, self.depth / nz)
     }
 
@@ -275,7 +319,10 @@ impl Geometry {
                     let (mut u, mut z) = (i as f64 * along, (k as f64 + 0.5) * dz);
                     if j > 0.0 {
                         u = (u + rng.random_range(-j..j) * along).clamp(0.0, len);
-                        z = (z + rng.random_range(-j..j) * dz).rem_euclid(self.depth);
+                        let shift = rng.random_range(-j..j) * dz;
+                        if !self.monolayer {
+                            z = (z + shift).rem_euclid(self.depth);
+                        }
                     }
                     let t = u / len;
                     out.push((Vec3::new(a[0] + t * dx, a[1] + t * dy, z), seg));
@@ -285,7 +332,8 @@ impl Geometry {
         out
     }
 
-    /// Volume of the channel (m³), for the expected grain count.
+    /// Volume of the channel (m³), for the expected grain count (a monolayer's: its area
+    /// times its thickness D).
     pub fn channel_volume(&self) -> f64 {
         (self.barrel_width * self.barrel_length + self.die_width * self.die_length) * self.depth
     }

@@ -218,7 +218,7 @@ pub fn place(
         let x = x_lo + rng.random::<f64>() * (x_hi - x_lo);
         let hw = g.half_width(x);
         let y = hw * (2.0 * rng.random::<f64>() - 1.0);
-        let z = rng.random::<f64>() * g.depth;
+        let z = g.grain_z(rng.random::<f64>());
         let p = Vec3::new(x, y, z);
         if !clear_of_walls(g, p, r) || !grid.clear(&dom, p, r) {
             fails += 1;

@@ -19,7 +19,7 @@ pub mod outlet;
 pub use balance::{Balance, SteadyRule};
 pub use driver::{ExtruderState, Measures};
 pub use error::ExtruderError;
-pub use geometry::{Geometry, Segment};
+pub use geometry::{Geometry, JAMMING_2D, JAMMING_3D, Segment, monolayer_thickness};
 pub use inlet::{Drive, Paste};
 
 use serde::{Deserialize, Serialize};
