@@ -3,7 +3,7 @@
 //! or vertical reference lines (a threshold such as Δp_c, a displacement such as 10 d̄).
 
 use super::legend;
-use super::plot::{FONT, SERIES_COLOURS, de, finite_range, render_png};
+use super::plot::{FONT, SERIES_COLOURS, de, finite_range, log_tick_label, render_png, tick_label};
 use anyhow::{Result, bail};
 use plotters::prelude::*;
 use std::path::Path;
@@ -62,6 +62,10 @@ fn padded(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+fn axis_label(v: f64, log: bool) -> String {
+    if log { log_tick_label(v) } else { tick_label(v) }
+}
+
 /// PNG of `lines` (800 × 560) with reference lines; a line's label goes in the legend.
 pub fn lines_png(path: &Path, lines: &[Line], opts: &LinesPlot) -> Result<()> {
     for l in lines {
@@ -115,6 +119,8 @@ pub fn lines_png(path: &Path, lines: &[Line], opts: &LinesPlot) -> Result<()> {
                     .configure_mesh()
                     .x_desc(opts.x_label)
                     .y_desc(opts.y_label)
+                    .x_label_formatter(&|v| axis_label(*v, opts.log_x))
+                    .y_label_formatter(&|v| axis_label(*v, opts.log_y))
                     .label_style((FONT, 13))
                     .light_line_style(RGBColor(235, 235, 235))
                     .draw()

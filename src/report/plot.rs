@@ -293,6 +293,21 @@ pub fn tick_label(v: f64) -> String {
     exp.map_or_else(|| mant.to_string(), |e| format!("{mant}e{e}"))
 }
 
+/// A tick label on a log axis: only 1, 2 and 5 times a power of ten are labelled (plotters
+/// puts a key point at every mantissa, whose labels overprint each other near a decade), each
+/// as [`tick_label`].
+pub fn log_tick_label(v: f64) -> String {
+    if !(v > 0.0 && v.is_finite()) {
+        return String::new();
+    }
+    let m = v / 10f64.powf(v.log10().floor());
+    if [1.0, 2.0, 5.0, 10.0].iter().any(|k| (m / k - 1.0).abs() < 1e-6) {
+        tick_label(v)
+    } else {
+        String::new()
+    }
+}
+
 /// PNG x-y plot of one or more series (lines, or markers where `points`).
 pub fn xy_png(path: &Path, series: &[Series], opts: &XyPlot) -> Result<()> {
     for s in series {
@@ -511,6 +526,14 @@ mod tests {
         assert_eq!(tick_label(2.5e-5), "2.5e-5");
         assert_eq!(tick_label(1e-14), "1e-14");
         assert_eq!(tick_label(0.0), "0");
+        // Log axes: 1, 2, 5 per decade, the rest blank.
+        assert_eq!(log_tick_label(2e5), "2e5");
+        assert_eq!(log_tick_label(1000000.0), "1e6");
+        assert_eq!(log_tick_label(5.0), "5");
+        assert_eq!(log_tick_label(0.999999999 * 1e3), "1000");
+        assert_eq!(log_tick_label(3e5), "");
+        assert_eq!(log_tick_label(900000.0), "");
+        assert_eq!(log_tick_label(0.0), "");
     }
 
     #[test]
