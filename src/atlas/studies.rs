@@ -322,8 +322,15 @@ pub fn paired_shifts<T: PartialEq + Clone>(
 /// |mean paired shift| + 2 standard errors of the `result` column against the replica's case at
 /// the `reference` value (0 for the reference itself; infinite where replicas that finished at
 /// the reference failed).
-pub fn paired(study: &str, sweep: &Path, axis: &str, reference: f64, result: &str) -> Result<Vec<Point>> {
-    let mut shifts = paired_shifts(study, sweep, axis, &reference, result, f64_column, None)
+pub fn paired(
+    study: &str,
+    sweep: &Path,
+    axis: &str,
+    reference: f64,
+    result: &str,
+    time: Option<&str>,
+) -> Result<Vec<Point>> {
+    let mut shifts = paired_shifts(study, sweep, axis, &reference, result, f64_column, time)
         .map_err(|e| anyhow::anyhow!("{e} (reference {axis} = {reference}; docs/atlas.md)"))?;
     shifts.sort_by(|a, b| a.at.total_cmp(&b.at));
     Ok(shifts
@@ -337,6 +344,51 @@ pub fn paired(study: &str, sweep: &Path, axis: &str, reference: f64, result: &st
             },
             value: s.at,
             // A setting with failed replicas is not an answer, whatever its finished ones say.
+            error: if s.failed > 0 {
+                f64::INFINITY
+            } else if s.at == reference {
+                0.0
+            } else {
+                s.mean().abs() + 2.0 * s.standard_error()
+            },
+            wall_seconds: s.wall_seconds,
+        })
+        .collect())
+}
+
+/// As [`paired`] for an axis of names (e.g. a sweep over `scene.simplify`: "none",
+/// "monolayer"): the points in the order the names first appear, `value` their index; `time`
+/// names a result column to time cases by (e.g. the simulation's own wall time) instead of the
+/// whole case's.
+pub fn paired_named(
+    study: &str,
+    sweep: &Path,
+    axis: &str,
+    reference: &str,
+    result: &str,
+    time: Option<&str>,
+) -> Result<Vec<Point>> {
+    let shifts = paired_shifts(
+        study,
+        sweep,
+        axis,
+        &reference.to_string(),
+        result,
+        str_column,
+        time,
+    )
+    .map_err(|e| anyhow::anyhow!("{e} (reference {axis} = {reference}; docs/atlas.md)"))?;
+    Ok(shifts
+        .into_iter()
+        .enumerate()
+        .map(|(k, s)| Point {
+            study: study.into(),
+            setting: if s.failed > 0 {
+                format!("{} ({} of {} failed)", s.at, s.failed, s.of)
+            } else {
+                s.at.clone()
+            },
+            value: k as f64,
             error: if s.failed > 0 {
                 f64::INFINITY
             } else if s.at == reference {
@@ -368,7 +420,7 @@ mod tests {
             "case,wall_s\na0,4\na1,4\na2,4\nb0,2\nb1,2\nb2,2\nc0,1\nc1,1\nc2,1\n",
         )
         .unwrap();
-        let p = paired("s", d.path(), "f", 1.0, "eps_vol_end").unwrap();
+        let p = paired("s", d.path(), "f", 1.0, "eps_vol_end", None).unwrap();
         assert_eq!(p.len(), 3);
         assert_eq!((p[0].error, p[0].wall_seconds), (0.0, 4.0));
         assert!(
@@ -378,9 +430,48 @@ mod tests {
         );
         assert_eq!(p[2].setting, "f 3 (2 of 3 failed)");
         assert!(p[2].error.is_infinite());
-        let e = paired("s", d.path(), "f", 9.0, "eps_vol_end")
+        let e = paired("s", d.path(), "f", 9.0, "eps_vol_end", None)
             .unwrap_err()
             .to_string();
         assert!(e.contains("f = 9"), "{e}");
+    }
+
+    /// Named settings, paired by replica, timed by a result column: "none" the reference,
+    /// "cut" shifted by 1, 2, 3 (bound 2 + 2/√3), "flat" by −4 on one replica of two (the other
+    /// failed: infinite).
+    #[test]
+    fn named_settings_pair_by_replica_and_time_by_a_result_column() {
+        let d = tempfile::tempdir().unwrap();
+        std::fs::write(
+            d.path().join("results.csv"),
+            "case,simplify,replica,v,sim_wall\na0,none,0,0.0,10\na1,none,1,1.0,10\na2,none,2,2.0,10\n\
+             b0,cut,0,1.0,6\nb1,cut,1,3.0,6\nb2,cut,2,5.0,6\nc0,flat,0,-4.0,1\n",
+        )
+        .unwrap();
+        std::fs::write(d.path().join("cases.csv"), "case,wall_s\na0,99\n").unwrap();
+        let p = paired_named("s", d.path(), "simplify", "none", "v", Some("sim_wall")).unwrap();
+        let got: Vec<(&str, f64, f64)> = p
+            .iter()
+            .map(|q| (q.setting.as_str(), q.value, q.wall_seconds))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("none", 0.0, 10.0),
+                ("cut", 1.0, 6.0),
+                ("flat (2 of 3 failed)", 2.0, 1.0)
+            ]
+        );
+        assert_eq!(p[0].error, 0.0);
+        assert!(
+            (p[1].error - (2.0 + 2.0 / 3f64.sqrt())).abs() < 1e-12,
+            "{:?}",
+            p[1]
+        );
+        assert!(p[2].error.is_infinite());
+        let e = paired_named("s", d.path(), "simplify", "full", "v", None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("simplify = full"), "{e}");
     }
 }

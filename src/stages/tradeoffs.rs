@@ -62,9 +62,32 @@ pub struct SweepStudy {
     /// The sweep's out directory.
     pub dir: PathBuf,
     pub axis: String,
-    pub reference: f64,
+    /// The axis value the others are compared with: a number (a mass scale, a step) or a name
+    /// (a `scene.simplify` value such as "none").
+    pub reference: Reference,
     #[serde(default = "eps_vol_end")]
     pub result: String,
+    /// A result column to time cases by (e.g. the simulation's own wall time) instead of the
+    /// whole case's wall time in cases.csv.
+    #[serde(default)]
+    pub time: Option<String>,
+}
+
+/// A study's reference setting.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Reference {
+    Value(f64),
+    Name(String),
+}
+
+impl std::fmt::Display for Reference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Reference::Value(v) => write!(f, "{v}"),
+            Reference::Name(n) => f.write_str(n),
+        }
+    }
 }
 
 fn eps_vol_end() -> String {
@@ -221,25 +244,28 @@ impl Stage for Tradeoffs {
             bar.inc(1);
         }
         for s in &p.sweeps {
-            points.extend(studies::paired(
-                &s.study,
-                &ctx.resolve(&s.dir),
-                &s.axis,
-                s.reference,
-                &s.result,
-            )?);
+            let dir = ctx.resolve(&s.dir);
+            points.extend(match &s.reference {
+                Reference::Value(r) => {
+                    studies::paired(&s.study, &dir, &s.axis, *r, &s.result, s.time.as_deref())?
+                }
+                Reference::Name(r) => {
+                    studies::paired_named(&s.study, &dir, &s.axis, r, &s.result, s.time.as_deref())?
+                }
+            });
             charts.push(Chart {
                 study: s.study.clone(),
                 file: format!("tradeoff_{}.png", s.study),
                 title: format!("{}: paired shift of {} against {} = {}", s.study, s.result, s.axis, s.reference),
                 error: format!("|mean Δ{}| + 2 SE", s.result),
                 caption: format!(
-                    "{} From the sweep in {}: per value of {}, the mean wall time of a case and the bound on the shift \
-                     of {} against {} = {} on the same replicas (mean paired shift plus two standard errors; 0 for the \
-                     reference itself).",
+                    "{} From the sweep in {}: per value of {}, the mean wall time of a case ({}) and the bound on the \
+                     shift of {} against {} = {} on the same replicas (mean paired shift plus two standard errors; 0 for \
+                     the reference itself).",
                     s.what,
                     s.dir.display(),
                     s.axis,
+                    s.time.as_deref().map_or_else(|| "cases.csv's wall_s".to_string(), |t| format!("its {t}")),
                     s.result,
                     s.axis,
                     s.reference
