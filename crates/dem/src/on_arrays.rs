@@ -9,3 +9,6 @@ pub(crate) mod kick;
 #[allow(clippy::duplicate_mod)]
 #[path = "pair_lanes.rs"]
 pub(crate) mod pair;
+#[allow(clippy::duplicate_mod)]
+#[path = "sphere_lanes.rs"]
+pub(crate) mod sphere;

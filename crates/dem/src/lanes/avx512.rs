@@ -100,6 +100,15 @@ impl F8 {
     pub(crate) fn ge(self, o: F8) -> M8 {
         M8(unsafe { _mm512_cmp_pd_mask::<_CMP_GE_OQ>(self.0, o.0) })
     }
+    #[inline(always)]
+    pub(crate) fn le(self, o: F8) -> M8 {
+        M8(unsafe { _mm512_cmp_pd_mask::<_CMP_LE_OQ>(self.0, o.0) })
+    }
+    /// Lanes where self != o, NaN included (Rust's `!=`).
+    #[inline(always)]
+    pub(crate) fn ne(self, o: F8) -> M8 {
+        M8(unsafe { _mm512_cmp_pd_mask::<_CMP_NEQ_UQ>(self.0, o.0) })
+    }
     /// Lanes that are not in [lo, hi) (NaN included).
     #[inline(always)]
     pub(crate) fn outside(self, lo: F8, hi: F8) -> M8 {
@@ -210,6 +219,18 @@ impl M8 {
     pub(crate) fn bit(self, k: usize) -> bool {
         (self.0 >> k) & 1 != 0
     }
+    #[inline(always)]
+    pub(crate) fn and(self, o: M8) -> M8 {
+        M8(self.0 & o.0)
+    }
+    #[inline(always)]
+    pub(crate) fn or(self, o: M8) -> M8 {
+        M8(self.0 | o.0)
+    }
+    #[inline(always)]
+    pub(crate) fn not(self) -> M8 {
+        M8(!self.0)
+    }
 }
 
 // The line moves of the pair kernel: shuffles instead of eight scalar loads per field.
@@ -226,6 +247,28 @@ pub(crate) fn transpose8(cst: &[CircleState], idx: &[usize; W]) -> [F8; 8] {
             *v = F8(_mm512_load_pd(p.add(i).cast::<f64>()));
         }
         transpose_registers(r)
+    }
+}
+
+/// The sixteen columns of the eight sphere lines `lines[idx[k]]` (two 64-byte lines each).
+#[inline(always)]
+pub(crate) fn transpose16(lines: &[crate::spheres::hm_batched::SphereLine], idx: &[usize; W]) -> [F8; 16] {
+    let p = lines.as_ptr();
+    // SAFETY: AVX-512 code runs only where the CPU has it (module doc); every idx[k] <
+    // lines.len() (asserted by the caller); SphereLine is repr(C), 128 bytes, 64-byte aligned.
+    unsafe {
+        let mut a = [F8(_mm512_setzero_pd()); W];
+        let mut b = [F8(_mm512_setzero_pd()); W];
+        for k in 0..W {
+            let q = p.add(idx[k]).cast::<f64>();
+            a[k] = F8(_mm512_load_pd(q));
+            b[k] = F8(_mm512_load_pd(q.add(8)));
+        }
+        let (a, b) = (transpose_registers(a), transpose_registers(b));
+        let mut r = [F8(_mm512_setzero_pd()); 16];
+        r[..W].copy_from_slice(&a);
+        r[W..].copy_from_slice(&b);
+        r
     }
 }
 

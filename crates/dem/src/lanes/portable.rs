@@ -81,6 +81,15 @@ impl F8 {
     pub(crate) fn ge(self, o: F8) -> M8 {
         M8(std::array::from_fn(|k| if self.0[k] >= o.0[k] { !0 } else { 0 }))
     }
+    #[inline(always)]
+    pub(crate) fn le(self, o: F8) -> M8 {
+        M8(std::array::from_fn(|k| if self.0[k] <= o.0[k] { !0 } else { 0 }))
+    }
+    /// Lanes where self != o, NaN included (Rust's `!=`).
+    #[inline(always)]
+    pub(crate) fn ne(self, o: F8) -> M8 {
+        M8(std::array::from_fn(|k| if self.0[k] != o.0[k] { !0 } else { 0 }))
+    }
     /// Lanes that are not in [lo, hi) (NaN included).
     #[inline(always)]
     pub(crate) fn outside(self, lo: F8, hi: F8) -> M8 {
@@ -131,12 +140,31 @@ impl M8 {
     pub(crate) fn any(self) -> bool {
         self.0.iter().any(|&m| m != 0)
     }
+    #[inline(always)]
+    pub(crate) fn and(self, o: M8) -> M8 {
+        M8(std::array::from_fn(|k| self.0[k] & o.0[k]))
+    }
+    #[inline(always)]
+    pub(crate) fn or(self, o: M8) -> M8 {
+        M8(std::array::from_fn(|k| self.0[k] | o.0[k]))
+    }
+    #[inline(always)]
+    pub(crate) fn not(self) -> M8 {
+        M8(self.0.map(|m| !m))
+    }
 }
 
 /// Columns 0..7 of the eight lines `cst[idx[k]]`.
 #[inline(always)]
 pub(crate) fn transpose8(cst: &[CircleState], idx: &[usize; W]) -> [F8; 8] {
     let rows: [[f64; W]; W] = std::array::from_fn(|k| cst[idx[k]].line());
+    std::array::from_fn(|f| F8(std::array::from_fn(|k| rows[k][f])))
+}
+
+/// The sixteen columns of the eight sphere lines `lines[idx[k]]`.
+#[inline(always)]
+pub(crate) fn transpose16(lines: &[crate::spheres::hm_batched::SphereLine], idx: &[usize; W]) -> [F8; 16] {
+    let rows: [&[f64; 16]; W] = std::array::from_fn(|k| &lines[idx[k]].0);
     std::array::from_fn(|f| F8(std::array::from_fn(|k| rows[k][f])))
 }
 

@@ -31,6 +31,7 @@ pub mod domain;
 pub mod edit;
 pub mod error;
 pub mod extruder;
+pub(crate) mod hm_batched;
 pub mod hook;
 pub mod law;
 pub mod stepper;

@@ -18,6 +18,7 @@
 use super::cells::CellList3;
 use super::clump::{Clumps, free_rotation, quat_array};
 use super::error::SphereError;
+use super::hm_batched::{HmChunk, HmPair, PairRecord, SphereLine, pack};
 use super::hook::{NoHook, SphereForceHook, user_forces};
 use super::law::{Interaction, Response, SphereLaw, TimeStepLimit};
 use super::stress::{ContactForce, Partner};
@@ -68,6 +69,10 @@ pub struct SphereStepper<L: SphereLaw> {
     hits: Vec<Option<PairHit>>,
     /// The pair pass's per-pair sums when not recording (scratch, list order).
     sums: Vec<Option<PairSum>>,
+    /// The spheres packed for the batched Hertz-Mindlin kernel, and its per-pair results
+    /// (scratch; used when the law has that kernel and no records are kept).
+    lines: Vec<SphereLine>,
+    batched: Vec<PairRecord>,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
@@ -83,6 +88,8 @@ impl<L: SphereLaw> Default for SphereStepper<L> {
             record: false,
             hits: Vec::new(),
             sums: Vec::new(),
+            lines: Vec::new(),
+            batched: Vec::new(),
             rebuilds: 0,
         }
     }
@@ -321,11 +328,50 @@ impl<L: SphereLaw> SphereStepper<L> {
         s.force.fill(Vec3::ZERO);
         s.torque.fill(Vec3::ZERO);
         self.records.clear();
-        let hist = c.hist.conform::<L::History>(c.pairs.len());
         // The laws in parallel (each pair reads the spheres and writes only its own history),
         // then the sums in list order, serially: the same additions in the same order whatever
         // the thread count, so the bits do not depend on it.
-        if !self.record {
+        let hm = law.hertz_mindlin_pairs().filter(|_| !self.record);
+        if let Some(k) = hm {
+            // The batched kernel (same bits as the generic pass below; spheres::hm_batched).
+            self.hits.clear();
+            let kp = HmPair::new(&k, &dom, p.dt);
+            pack(
+                &mut self.lines,
+                &s.pos,
+                &s.vel,
+                &s.omega,
+                &s.radius,
+                &s.frozen,
+                |k| body_mass(s, cl, k),
+            );
+            let springs = c.hist.conform::<Vec3>(c.pairs.len());
+            let n = c.pairs.len();
+            self.batched.resize(n, PairRecord::default());
+            let lines = &self.lines;
+            c.pairs
+                .par_chunks(PAIR_CHUNK)
+                .zip(springs.par_chunks_mut(PAIR_CHUNK))
+                .zip(self.batched.par_chunks_mut(PAIR_CHUNK))
+                .for_each(|((pairs, hist), out)| {
+                    lbdem_core::simd::dispatch(HmChunk {
+                        kernel: &kp,
+                        lines,
+                        pairs,
+                        hist,
+                        out,
+                    })
+                });
+            for (pair, r) in c.pairs.iter().zip(&self.batched) {
+                let (i, j) = (pair[0] as usize, pair[1] as usize);
+                let [f, ti, tj] = [r.f, r.ti, r.tj].map(|v| Vec3::new(v[0], v[1], v[2]));
+                s.force[i] += f;
+                s.force[j] -= f;
+                s.torque[i] += ti;
+                s.torque[j] += tj;
+            }
+        } else if !self.record {
+            let hist = c.hist.conform::<L::History>(c.pairs.len());
             // No stale records' hits summed below.
             self.hits.clear();
             // Only what the sums need (the force on i, the torques on i and j): 80 bytes a
@@ -349,6 +395,7 @@ impl<L: SphereLaw> SphereStepper<L> {
                 s.torque[j] += tj;
             }
         } else {
+            let hist = c.hist.conform::<L::History>(c.pairs.len());
             pair_pass(law, &dom, s, cl, p.dt, &c.pairs, hist, &mut self.hits, |hit| hit);
         }
         for (pair, hit) in c.pairs.iter().zip(&self.hits) {

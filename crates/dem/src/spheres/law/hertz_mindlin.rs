@@ -225,6 +225,11 @@ impl SphereLaw for HertzMindlinSpring {
         check_fraction("rayleigh_fraction", self.rayleigh_fraction)
     }
 
+    #[inline]
+    fn hertz_mindlin_pairs(&self) -> Option<Coeffs> {
+        Some(self.pair_coeffs())
+    }
+
     fn max_time_step(&self, r: f64, m: f64) -> TimeStepLimit {
         TimeStepLimit {
             dt: self.rayleigh_fraction * self.rayleigh_time_step(r, m),

@@ -101,6 +101,13 @@ pub trait SphereLaw: Clone + PartialEq + Send + Sync {
     /// The largest time step (s) this law accepts for a sphere of radius `r` and mass `m`
     /// (against an identical sphere and against a wall), and what sets it.
     fn max_time_step(&self, r: f64, m: f64) -> TimeStepLimit;
+    /// The sphere-sphere constants of the Hertz-Mindlin spring law, if this is it: the stepper
+    /// then evaluates pairs with the batched kernel (`spheres::hm_batched`, the same bits as
+    /// [`Self::force`]). Default: none, every pair through `force`.
+    #[inline]
+    fn hertz_mindlin_pairs(&self) -> Option<hertz_mindlin::Coeffs> {
+        None
+    }
 }
 
 /// A time-step bound and its origin, for the refusal message.
