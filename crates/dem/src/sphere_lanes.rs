@@ -31,25 +31,41 @@ pub(crate) fn run(
         assert!(ix.iter().chain(&jx).all(|&c| c < nl), "pair index out of range");
         let si = lanes::transpose16(lines, &ix);
         let sj = lanes::transpose16(lines, &jx);
-        let h0 = [
-            F8::from_array(std::array::from_fn(|k| hist[lane(k)].x)),
-            F8::from_array(std::array::from_fn(|k| hist[lane(k)].y)),
-            F8::from_array(std::array::from_fn(|k| hist[lane(k)].z)),
-        ];
-        let r = eight(kp, &si, &sj, h0);
-        let [hx, hy, hz] = r.hist.map(F8::to_array);
-        let f = r.f.map(F8::to_array);
-        let ti = r.ti.map(F8::to_array);
-        let tj = r.tj.map(F8::to_array);
-        for k in 0..m {
-            hist[q + k] = Vec3::new(hx[k], hy[k], hz[k]);
-            out[q + k] = PairRecord {
-                f: [f[0][k], f[1][k], f[2][k]],
-                ti: [ti[0][k], ti[1][k], ti[2][k]],
-                tj: [tj[0][k], tj[1][k], tj[2][k]],
-            };
+        if m == W {
+            let h: &mut [Vec3; W] = (&mut hist[q..q + W]).try_into().expect("eight springs");
+            let h: &mut [[f64; 3]; W] = bytemuck::cast_mut(h);
+            let r = eight(kp, &si, &sj, lanes::load3(h));
+            lanes::store3(h, r.hist);
+            store_records(&mut out[q..q + W], &r);
+        } else {
+            let h0 = [
+                F8::from_array(std::array::from_fn(|k| hist[lane(k)].x)),
+                F8::from_array(std::array::from_fn(|k| hist[lane(k)].y)),
+                F8::from_array(std::array::from_fn(|k| hist[lane(k)].z)),
+            ];
+            let r = eight(kp, &si, &sj, h0);
+            let [hx, hy, hz] = r.hist.map(F8::to_array);
+            for k in 0..m {
+                hist[q + k] = Vec3::new(hx[k], hy[k], hz[k]);
+            }
+            store_records(&mut out[q..q + m], &r);
         }
         q += m;
+    }
+}
+
+/// The first `out.len()` lanes of `r` as pair records.
+#[inline(always)]
+fn store_records(out: &mut [PairRecord], r: &LaneOut) {
+    let f = r.f.map(F8::to_array);
+    let ti = r.ti.map(F8::to_array);
+    let tj = r.tj.map(F8::to_array);
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = PairRecord {
+            f: [f[0][k], f[1][k], f[2][k]],
+            ti: [ti[0][k], ti[1][k], ti[2][k]],
+            tj: [tj[0][k], tj[1][k], tj[2][k]],
+        };
     }
 }
 

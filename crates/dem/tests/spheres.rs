@@ -416,7 +416,7 @@ fn a_large_system_gives_the_same_bits_on_one_and_two_threads() {
 /// hundreds of steps, on a periodic box with walls and gravity (with frozen spheres and two
 /// tetrahedral clumps among the free ones), and on a Lees-Edwards box (pairs across the
 /// sheared faces, whose images move), each at the SIMD level the CPU offers and on one thread
-/// and two.
+/// and two; and a system above the size from which the packing and the sums use the pool.
 #[test]
 fn the_batched_hertz_mindlin_kernel_gives_the_scalar_pass_bits() {
     let frame = BodyFrame::of(
@@ -469,4 +469,20 @@ fn the_batched_hertz_mindlin_kernel_gives_the_scalar_pass_bits() {
         );
         assert!(go(false, 2) == scalar, "{name}: two threads part");
     }
+    // From 8192 spheres the lines are packed on the pool and the force and torque sums run
+    // side by side: still the scalar pass's bits.
+    let big = packed(21, [true, true, false], 11);
+    let go = |record: bool| {
+        crate::common::on_threads(2, || {
+            let mut s = big.clone();
+            let mut st = SphereStepper::new();
+            st.record_contacts(record);
+            run(&mut s, &mut st, &params(), 60);
+            s
+        })
+    };
+    assert!(
+        go(false) == go(true),
+        "the large system parts from the scalar pass"
+    );
 }

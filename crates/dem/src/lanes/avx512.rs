@@ -272,6 +272,46 @@ pub(crate) fn transpose16(lines: &[crate::spheres::hm_batched::SphereLine], idx:
     }
 }
 
+/// x, y and z lanes of eight packed (x, y, z) records (24 f64).
+#[inline(always)]
+pub(crate) fn load3(p: &[[f64; 3]; W]) -> [F8; 3] {
+    // SAFETY: as above; reads the 24 f64 of `p` as three unaligned lines.
+    unsafe {
+        let q = p.as_ptr().cast::<f64>();
+        let (l0, l1, l2) = (
+            _mm512_loadu_pd(q),
+            _mm512_loadu_pd(q.add(8)),
+            _mm512_loadu_pd(q.add(16)),
+        );
+        let x = _mm512_permutex2var_pd(l0, _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0), l1);
+        let x = _mm512_permutex2var_pd(x, _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13), l2);
+        let y = _mm512_permutex2var_pd(l0, _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0), l1);
+        let y = _mm512_permutex2var_pd(y, _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14), l2);
+        let z = _mm512_permutex2var_pd(l0, _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0), l1);
+        let z = _mm512_permutex2var_pd(z, _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15), l2);
+        [F8(x), F8(y), F8(z)]
+    }
+}
+
+/// The inverse of [`load3`].
+#[inline(always)]
+pub(crate) fn store3(p: &mut [[f64; 3]; W], v: [F8; 3]) {
+    let [x, y, z] = [v[0].0, v[1].0, v[2].0];
+    // SAFETY: as above; writes the 24 f64 of `p`.
+    unsafe {
+        let a = _mm512_permutex2var_pd(x, _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), y);
+        let l0 = _mm512_permutex2var_pd(a, _mm512_setr_epi64(0, 1, 8, 3, 4, 9, 6, 7), z);
+        let b = _mm512_permutex2var_pd(x, _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), y);
+        let l1 = _mm512_permutex2var_pd(b, _mm512_setr_epi64(10, 1, 2, 11, 4, 5, 12, 7), z);
+        let c = _mm512_permutex2var_pd(x, _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), y);
+        let l2 = _mm512_permutex2var_pd(c, _mm512_setr_epi64(0, 13, 2, 3, 14, 5, 6, 15), z);
+        let q = p.as_mut_ptr().cast::<f64>();
+        _mm512_storeu_pd(q, l0);
+        _mm512_storeu_pd(q.add(8), l1);
+        _mm512_storeu_pd(q.add(16), l2);
+    }
+}
+
 /// History k = [x y θ δp]: two histories per 512-bit line.
 #[inline(always)]
 pub(crate) fn hist_load(h: &[History; W]) -> (F8, F8, [F8; 2]) {

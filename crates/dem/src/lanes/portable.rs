@@ -168,6 +168,20 @@ pub(crate) fn transpose16(lines: &[crate::spheres::hm_batched::SphereLine], idx:
     std::array::from_fn(|f| F8(std::array::from_fn(|k| rows[k][f])))
 }
 
+/// x, y and z lanes of eight packed (x, y, z) records.
+#[inline(always)]
+pub(crate) fn load3(p: &[[f64; 3]; W]) -> [F8; 3] {
+    std::array::from_fn(|c| F8(std::array::from_fn(|k| p[k][c])))
+}
+
+/// The inverse of [`load3`].
+#[inline(always)]
+pub(crate) fn store3(p: &mut [[f64; 3]; W], v: [F8; 3]) {
+    for (k, rec) in p.iter_mut().enumerate() {
+        *rec = [v[0].0[k], v[1].0[k], v[2].0[k]];
+    }
+}
+
 /// Tangential elongations of eight histories, and their other two fields.
 #[inline(always)]
 pub(crate) fn hist_load(h: &[History; W]) -> (F8, F8, [F8; 2]) {

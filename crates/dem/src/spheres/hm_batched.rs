@@ -14,6 +14,7 @@ use super::domain::Domain3;
 use super::law::hertz_mindlin::Coeffs;
 use crate::vector::Vec3;
 use lbdem_core::simd::{Simd, WithSimd};
+use rayon::prelude::*;
 
 /// One sphere as the lane kernel reads it: x, y, z, v (3), ω (3), r, the mass of the body it
 /// moves with, 1 if frozen (else 0), padding to two 64-byte lines.
@@ -98,7 +99,8 @@ impl HmPair {
 }
 
 /// The lines of every sphere: position, velocity, spin, radius, the mass of its body
-/// (`body_mass`), frozen or not.
+/// (`body_mass`), frozen or not; on rayon's threads if `parallel` (each line on its own).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn pack(
     lines: &mut Vec<SphereLine>,
     pos: &[Vec3],
@@ -106,10 +108,10 @@ pub(crate) fn pack(
     omega: &[Vec3],
     radius: &[f64],
     frozen: &[bool],
-    body_mass: impl Fn(usize) -> f64,
+    body_mass: impl Fn(usize) -> f64 + Sync,
+    parallel: bool,
 ) {
-    lines.clear();
-    lines.extend((0..pos.len()).map(|k| {
+    let line = |k: usize| {
         let mut l = [0.0; 16];
         let (p, v, w) = (pos[k], vel[k], omega[k]);
         l[field::X..field::X + 3].copy_from_slice(&[p.x, p.y, p.z]);
@@ -119,7 +121,19 @@ pub(crate) fn pack(
         l[field::M] = body_mass(k);
         l[field::FROZEN] = if frozen[k] { 1.0 } else { 0.0 };
         SphereLine(l)
-    }));
+    };
+    lines.resize(pos.len(), SphereLine::default());
+    if parallel {
+        lines
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(k, l)| *l = line(k));
+    } else {
+        for (k, l) in lines.iter_mut().enumerate() {
+            *l = line(k);
+        }
+    }
 }
 
 /// One chunk of the pair pass as an op of `lbdem_core::simd::dispatch`.

@@ -344,10 +344,10 @@ impl<L: SphereLaw> SphereStepper<L> {
                 &s.radius,
                 &s.frozen,
                 |k| body_mass(s, cl, k),
+                n >= PARALLEL_SPHERES,
             );
             let springs = c.hist.conform::<Vec3>(c.pairs.len());
-            let n = c.pairs.len();
-            self.batched.resize(n, PairRecord::default());
+            self.batched.resize(c.pairs.len(), PairRecord::default());
             let lines = &self.lines;
             c.pairs
                 .par_chunks(PAIR_CHUNK)
@@ -362,13 +362,35 @@ impl<L: SphereLaw> SphereStepper<L> {
                         out,
                     })
                 });
-            for (pair, r) in c.pairs.iter().zip(&self.batched) {
-                let (i, j) = (pair[0] as usize, pair[1] as usize);
-                let [f, ti, tj] = [r.f, r.ti, r.tj].map(|v| Vec3::new(v[0], v[1], v[2]));
-                s.force[i] += f;
-                s.force[j] -= f;
-                s.torque[i] += ti;
-                s.torque[j] += tj;
+            // Forces and torques are separate sums, each in list order: on two threads they run
+            // side by side, on one in a single pass; the same bits either way.
+            let (pairs, recs) = (&c.pairs, &self.batched);
+            let (force, torque) = (&mut s.force, &mut s.torque);
+            if n < PARALLEL_SPHERES || rayon::current_num_threads() < 2 {
+                for (pair, r) in pairs.iter().zip(recs) {
+                    let (i, j) = (pair[0] as usize, pair[1] as usize);
+                    let f = Vec3::new(r.f[0], r.f[1], r.f[2]);
+                    force[i] += f;
+                    force[j] -= f;
+                    torque[i] += Vec3::new(r.ti[0], r.ti[1], r.ti[2]);
+                    torque[j] += Vec3::new(r.tj[0], r.tj[1], r.tj[2]);
+                }
+            } else {
+                rayon::join(
+                    || {
+                        for (pair, r) in pairs.iter().zip(recs) {
+                            let f = Vec3::new(r.f[0], r.f[1], r.f[2]);
+                            force[pair[0] as usize] += f;
+                            force[pair[1] as usize] -= f;
+                        }
+                    },
+                    || {
+                        for (pair, r) in pairs.iter().zip(recs) {
+                            torque[pair[0] as usize] += Vec3::new(r.ti[0], r.ti[1], r.ti[2]);
+                            torque[pair[1] as usize] += Vec3::new(r.tj[0], r.tj[1], r.tj[2]);
+                        }
+                    },
+                );
             }
         } else if !self.record {
             let hist = c.hist.conform::<L::History>(c.pairs.len());
