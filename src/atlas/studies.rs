@@ -317,6 +317,19 @@ pub fn paired_shifts<T: PartialEq + Clone>(
         .collect())
 }
 
+/// A setting's error in a sweep study's chart: 0 at the reference, |mean paired shift| + 2
+/// standard errors elsewhere, infinite where replicas failed (a setting with failed replicas is
+/// not an answer, whatever its finished ones say).
+fn chart_error<T>(s: &Shift<T>, reference: bool) -> f64 {
+    if s.failed > 0 {
+        f64::INFINITY
+    } else if reference {
+        0.0
+    } else {
+        s.mean().abs() + 2.0 * s.standard_error()
+    }
+}
+
 /// A knob swept by a finished `lbdem sweep` with replicas (e.g. sweeps/su2020-mass-scaling.toml):
 /// per value of the `axis` column, the mean wall time of a case (cases.csv) and the bound
 /// |mean paired shift| + 2 standard errors of the `result` column against the replica's case at
@@ -343,14 +356,7 @@ pub fn paired(
                 format!("{axis} {}", s.at)
             },
             value: s.at,
-            // A setting with failed replicas is not an answer, whatever its finished ones say.
-            error: if s.failed > 0 {
-                f64::INFINITY
-            } else if s.at == reference {
-                0.0
-            } else {
-                s.mean().abs() + 2.0 * s.standard_error()
-            },
+            error: chart_error(&s, s.at == reference),
             wall_seconds: s.wall_seconds,
         })
         .collect())
@@ -389,13 +395,7 @@ pub fn paired_named(
                 s.at.clone()
             },
             value: k as f64,
-            error: if s.failed > 0 {
-                f64::INFINITY
-            } else if s.at == reference {
-                0.0
-            } else {
-                s.mean().abs() + 2.0 * s.standard_error()
-            },
+            error: chart_error(&s, s.at == reference),
             wall_seconds: s.wall_seconds,
         })
         .collect())

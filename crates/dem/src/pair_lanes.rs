@@ -41,12 +41,8 @@ fn run_law<const GAMMA: bool, const PLASTIC: bool>(
     let nc = cst.len();
     let mut q = 0;
     while q < n {
-        let m = (n - q).min(W);
-        // Lanes past the end repeat the last pair; only the first m are stored.
+        let (m, ix, jx) = crate::lanes::batch(pairs, q, nc);
         let lane = |k: usize| q + k.min(m - 1);
-        let ix: [usize; W] = std::array::from_fn(|k| pairs[lane(k)][0] as usize);
-        let jx: [usize; W] = std::array::from_fn(|k| pairs[lane(k)][1] as usize);
-        assert!(ix.iter().chain(&jx).all(|&c| c < nc), "pair index out of range");
         let ci = Lanes::gather(cst, &ix);
         let cj = Lanes::gather(cst, &jx);
         if m == W {

@@ -23,12 +23,8 @@ pub(crate) fn run(
     let nl = lines.len();
     let mut q = 0;
     while q < n {
-        let m = (n - q).min(W);
-        // Lanes past the end repeat the last pair; only the first m are stored.
+        let (m, ix, jx) = crate::lanes::batch(pairs, q, nl);
         let lane = |k: usize| q + k.min(m - 1);
-        let ix: [usize; W] = std::array::from_fn(|k| pairs[lane(k)][0] as usize);
-        let jx: [usize; W] = std::array::from_fn(|k| pairs[lane(k)][1] as usize);
-        assert!(ix.iter().chain(&jx).all(|&c| c < nl), "pair index out of range");
         let si = lanes::transpose16(lines, &ix);
         let sj = lanes::transpose16(lines, &jx);
         if m == W {

@@ -270,13 +270,7 @@ fn the_fig9_sweeps_expand_to_checked_cases() {
     let cases = expand(&s, t.path()).unwrap();
     assert_eq!(cases.len(), 24);
     for (k, c) in cases.iter().enumerate() {
-        let sim = &c.pipeline.stages[0].params;
-        let l = crate::scenes::schema::load(
-            &root.join(sim["scene"].as_str().unwrap()),
-            sim["overrides"].as_table().unwrap(),
-        )
-        .unwrap();
-        let e = l.scene.extruder.unwrap();
+        let e = simulated_scene(root, c).scene.extruder.unwrap();
         let want = [
             (false, 5.0e-5),
             (
@@ -298,15 +292,19 @@ fn the_fig9_sweeps_expand_to_checked_cases() {
         (1.0, 0.0, 2e4),
     ];
     for (k, c) in cases.iter().enumerate() {
-        let sim = &c.pipeline.stages[0].params;
-        let l = crate::scenes::schema::load(
-            &root.join(sim["scene"].as_str().unwrap()),
-            sim["overrides"].as_table().unwrap(),
-        )
-        .unwrap();
-        let su = l.scene.suspension.unwrap();
+        let su = simulated_scene(root, c).scene.suspension.unwrap();
         assert_eq!((su.mu_p, su.mu_w, su.k_n), want[k / 2], "case {k}");
     }
+}
+
+/// The scene a sweep case's first stage (`simulate`) loads, with its overrides.
+fn simulated_scene(root: &Path, c: &crate::sweep::cases::Case) -> crate::scenes::schema::Loaded {
+    let sim = &c.pipeline.stages[0].params;
+    crate::scenes::schema::load(
+        &root.join(sim["scene"].as_str().unwrap()),
+        sim["overrides"].as_table().unwrap(),
+    )
+    .unwrap()
 }
 
 /// The reduced extruder run until its mass balance holds (stop_when_steady): insertion and

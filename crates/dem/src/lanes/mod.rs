@@ -25,3 +25,19 @@ pub(crate) const W: usize = 8;
 pub(crate) fn avx512_in<S: lbdem_core::simd::Simd>() -> bool {
     cfg!(target_arch = "x86_64") && lbdem_core::simd::is_v4::<S>()
 }
+
+/// The batch of `pairs` from `q`: how many are real (`m` ≤ W) and the i and j index of each
+/// lane (lanes past the end repeat the last pair; the kernels store the first `m` only), every
+/// index checked below `bodies`.
+#[inline(always)]
+pub(crate) fn batch(pairs: &[[u32; 2]], q: usize, bodies: usize) -> (usize, [usize; W], [usize; W]) {
+    let m = (pairs.len() - q).min(W);
+    let lane = |k: usize| q + k.min(m - 1);
+    let ix: [usize; W] = std::array::from_fn(|k| pairs[lane(k)][0] as usize);
+    let jx: [usize; W] = std::array::from_fn(|k| pairs[lane(k)][1] as usize);
+    assert!(
+        ix.iter().chain(&jx).all(|&c| c < bodies),
+        "pair index out of range"
+    );
+    (m, ix, jx)
+}
