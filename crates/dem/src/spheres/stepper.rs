@@ -6,8 +6,9 @@
 //! [`SphereForceHook`].
 //!
 //! Parallel where the time goes: the pair laws run on rayon's threads (each pair reads the
-//! spheres and writes only its own history), and their forces are then summed serially in list
-//! order, so results do not depend on the thread count; the kicks and the per-sphere checks run
+//! spheres and writes only its own history; the Hertz-Mindlin spring law eight pairs at a time,
+//! `super::hm_batched`), and their forces are then summed in list order (the force and torque
+//! sums side by side on two threads, each serial), so results do not depend on the thread count; the kicks and the per-sphere checks run
 //! on the threads too (each sphere on its own). Walls, gravity, clumps and the list's rebuild
 //! bookkeeping are serial.
 //! Determinism: the pair list is sorted (i < j), every pair beyond the law's range is skipped
@@ -23,7 +24,7 @@ use super::hook::{NoHook, SphereForceHook, user_forces};
 use super::law::{Interaction, Response, SphereLaw, TimeStepLimit};
 use super::stress::{ContactForce, Partner};
 use super::system::{FREE, SphereSystem, Spheres};
-use crate::history::Histories;
+use crate::history::{Histories, stride_of};
 use crate::neighbor::carry_history_into;
 use crate::vector::{Vec3, Vector};
 use rayon::prelude::*;
@@ -329,9 +330,12 @@ impl<L: SphereLaw> SphereStepper<L> {
         s.torque.fill(Vec3::ZERO);
         self.records.clear();
         // The laws in parallel (each pair reads the spheres and writes only its own history),
-        // then the sums in list order, serially: the same additions in the same order whatever
-        // the thread count, so the bits do not depend on it.
-        let hm = law.hertz_mindlin_pairs().filter(|_| !self.record);
+        // then the sums in list order (each array serially): the same additions in the same
+        // order whatever the thread count, so the bits do not depend on it. The Hertz-Mindlin
+        // spring law takes the batched kernel, whose springs are its `Vec3` histories.
+        let hm = law
+            .hertz_mindlin_pairs()
+            .filter(|_| !self.record && stride_of::<L::History>() == stride_of::<Vec3>());
         if let Some(k) = hm {
             // The batched kernel (same bits as the generic pass below; spheres::hm_batched).
             self.hits.clear();
