@@ -230,7 +230,7 @@ fn the_wall_realisation_sweep_expands_to_thirty_checked_cases() {
 /// sweeps/ness2017-fig9.toml (the full Fig. 9 sweep over pipelines/ness2017-case.toml) expands to
 /// 6 cases x 3 forces x 5 wall seeds, each case's simulate stage on its own Table 1 file with its
 /// force and seed, its analysis reading that run; the reduced flow sweep to its 4 forces, and
-/// the slab-against-monolayer sweep to its 24 cases (3 wall realisations).
+/// the slab-against-monolayer sweep to its 40 cases (5 wall realisations).
 /// Nothing is run.
 #[test]
 fn the_fig9_sweeps_expand_to_checked_cases() {
@@ -264,11 +264,11 @@ fn the_fig9_sweeps_expand_to_checked_cases() {
     }
     let s = Sweep::load(&root.join("sweeps/ness2017-reduced-flow.toml")).unwrap();
     assert_eq!(expand(&s, t.path()).unwrap().len(), 4);
-    // The slab against the monolayer: 2 layers x 4 forces x 3 walls, the layer's switch and thickness
+    // The slab against the monolayer: 2 layers x 4 forces x 5 walls, the layer's switch and thickness
     // reaching the scene.
     let s = Sweep::load(&root.join("sweeps/ness2017-reduced-layers.toml")).unwrap();
     let cases = expand(&s, t.path()).unwrap();
-    assert_eq!(cases.len(), 24);
+    assert_eq!(cases.len(), 40);
     for (k, c) in cases.iter().enumerate() {
         let e = simulated_scene(root, c).scene.extruder.unwrap();
         let want = [
@@ -278,7 +278,7 @@ fn the_fig9_sweeps_expand_to_checked_cases() {
                 lbdem_dem::spheres::extruder::monolayer_thickness([1.0e-5, 1.5e-5]),
             ),
         ];
-        assert_eq!((e.monolayer, e.depth), want[k / 12], "case {k}");
+        assert_eq!((e.monolayer, e.depth), want[k / 20], "case {k}");
     }
     // The reduced Table 1 cases: each case's friction and stiffness reach its simulate stage.
     let s = Sweep::load(&root.join("sweeps/ness2017-reduced-cases.toml")).unwrap();
