@@ -13,3 +13,6 @@ pub(crate) mod pair;
 #[allow(clippy::duplicate_mod)]
 #[path = "sphere_lanes.rs"]
 pub(crate) mod sphere;
+#[allow(clippy::duplicate_mod)]
+#[path = "sphere_kick_lanes.rs"]
+pub(crate) mod sphere_kick;

@@ -33,6 +33,7 @@ pub mod error;
 pub mod extruder;
 pub(crate) mod hm_batched;
 pub mod hook;
+pub(crate) mod kick_batched;
 pub mod law;
 pub mod stepper;
 pub mod stress;

@@ -21,6 +21,7 @@ use super::clump::{Clumps, free_rotation, quat_array};
 use super::error::SphereError;
 use super::hm_batched::{HmChunk, HmPair, PairRecord, SphereLine, pack};
 use super::hook::{NoHook, SphereForceHook, user_forces};
+use super::kick_batched::{KickChunk, KickInput};
 use super::law::{Interaction, Response, SphereLaw, TimeStepLimit};
 use super::stress::{ContactForce, Partner};
 use super::system::{FREE, SphereSystem, Spheres};
@@ -74,6 +75,8 @@ pub struct SphereStepper<L: SphereLaw> {
     /// (scratch; used when the law has that kernel and no records are kept).
     lines: Vec<SphereLine>,
     batched: Vec<PairRecord>,
+    /// 1.0 per mobile sphere for the kicks (scratch).
+    mobile: Vec<f64>,
     /// List rebuilds so far (diagnostic).
     pub rebuilds: u64,
 }
@@ -91,6 +94,7 @@ impl<L: SphereLaw> Default for SphereStepper<L> {
             sums: Vec::new(),
             lines: Vec::new(),
             batched: Vec::new(),
+            mobile: Vec::new(),
             rebuilds: 0,
         }
     }
@@ -213,7 +217,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         let dom = sys.domain;
         // Opening half kick and drift: mobile spheres (frozen ones stay), then clumps (members
         // placed on them).
-        kick(&mut sys.spheres, h, Some((dt, &dom)));
+        kick(&mut sys.spheres, h, Some((dt, &dom)), &mut self.mobile);
         let c = &mut sys.clumps;
         for k in 0..c.len() {
             c.vel[k] += c.force[k] * (h / c.mass[k]);
@@ -234,7 +238,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         }
         self.forces(p, law, sys, hook);
         // Closing half kick.
-        kick(&mut sys.spheres, h, None);
+        kick(&mut sys.spheres, h, None, &mut self.mobile);
         let c = &mut sys.clumps;
         for k in 0..c.len() {
             c.vel[k] += c.force[k] * (h / c.mass[k]);
@@ -524,9 +528,10 @@ const SPHERE_CHUNK: usize = 4096;
 const PARALLEL_SPHERES: usize = 2 * SPHERE_CHUNK;
 
 /// A half kick of the mobile spheres (v += F h/m, ω += T h/I) and, with `drift = Some((dt,
-/// domain))`, the drift x += v dt wrapped into the box. Each sphere on its own: parallel for
-/// large systems, and the same bits on any thread count.
-fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>) {
+/// domain))`, the drift x += v dt wrapped into the box, eight spheres at a time
+/// (`super::kick_batched`, the bits of the scalar form [`kick_scalar`]). Each sphere on its own:
+/// parallel for large systems, and the same bits on any thread count. `mobile` is scratch.
+fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>, mobile: &mut Vec<f64>) {
     let Spheres {
         pos,
         vel,
@@ -539,34 +544,58 @@ fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>) 
         frozen,
         ..
     } = s;
-    let one = |k: usize, x: &mut Vec3, v: &mut Vec3, w: &mut Vec3| {
-        // Mobile: free (no clump) and not frozen (as `SphereSystem::is_mobile`, which takes the
-        // whole system).
-        if owner.get(k).is_some_and(|&o| o != FREE) || frozen.get(k).is_some_and(|&f| f) {
-            return;
-        }
-        *v += force[k] * (h / mass[k]);
-        *w += torque[k] * (h / inertia[k]);
-        if let Some((dt, dom)) = drift {
-            (*x, *v) = dom.wrap_moving(*x + *v * dt, *v);
-        }
+    mobile.clear();
+    // Mobile: free (no clump) and not frozen (as `SphereSystem::is_mobile`).
+    mobile.extend((0..pos.len()).map(|k| {
+        let fixed = owner.get(k).is_some_and(|&o| o != FREE) || frozen.get(k).is_some_and(|&f| f);
+        if fixed { 0.0 } else { 1.0 }
+    }));
+    let inp = KickInput {
+        force,
+        torque,
+        mass,
+        inertia,
+        mobile,
+        h,
+        drift,
     };
     if pos.len() < PARALLEL_SPHERES {
-        for (k, ((x, v), w)) in pos
-            .iter_mut()
-            .zip(vel.iter_mut())
-            .zip(omega.iter_mut())
-            .enumerate()
-        {
-            one(k, x, v, w);
-        }
+        lbdem_core::simd::dispatch(KickChunk {
+            inp: &inp,
+            first: 0,
+            pos,
+            vel,
+            omega,
+        });
     } else {
-        pos.par_iter_mut()
-            .zip(vel.par_iter_mut())
-            .zip(omega.par_iter_mut())
+        pos.par_chunks_mut(SPHERE_CHUNK)
+            .zip(vel.par_chunks_mut(SPHERE_CHUNK))
+            .zip(omega.par_chunks_mut(SPHERE_CHUNK))
             .enumerate()
-            .with_min_len(SPHERE_CHUNK)
-            .for_each(|(k, ((x, v), w))| one(k, x, v, w));
+            .for_each(|(c, ((pos, vel), omega))| {
+                lbdem_core::simd::dispatch(KickChunk {
+                    inp: &inp,
+                    first: c * SPHERE_CHUNK,
+                    pos,
+                    vel,
+                    omega,
+                })
+            });
+    }
+}
+
+/// The kick one sphere at a time: the reference the batched kick is tested against.
+#[cfg(test)]
+fn kick_scalar(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>) {
+    for k in 0..s.len() {
+        if s.owner.get(k).is_some_and(|&o| o != FREE) || s.frozen.get(k).is_some_and(|&f| f) {
+            continue;
+        }
+        s.vel[k] += s.force[k] * (h / s.mass[k]);
+        s.omega[k] += s.torque[k] * (h / s.inertia[k]);
+        if let Some((dt, dom)) = drift {
+            (s.pos[k], s.vel[k]) = dom.wrap_moving(s.pos[k] + s.vel[k] * dt, s.vel[k]);
+        }
     }
 }
 
@@ -738,5 +767,71 @@ fn gather_clumps(sys: &mut SphereSystem, gravity: Vec3) {
         }
         c.force[k] = f + gravity * c.mass[k];
         c.torque[k] = t;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spheres::domain::Domain3;
+    use crate::vector::Vec3;
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// The batched kick against the scalar one, to the bit: random spheres (some frozen, some
+    /// owned by a clump, some pushed out of the box through every face, the Lees-Edwards y
+    /// faces included), counts that leave a tail of fewer than eight and one above the size
+    /// from which chunks run on the pool, with and without the drift.
+    #[test]
+    fn the_batched_kick_gives_the_scalar_kicks_bits() {
+        for (n, sheared) in [(37, false), (203, true), (PARALLEL_SPHERES + 13, true)] {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(n as u64);
+            let mut dom = Domain3::new(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0), [true, true, false]).unwrap();
+            if sheared {
+                dom = dom.with_lees_edwards(0.7).unwrap();
+                dom.advance(0.3);
+            }
+            let mut sys = SphereSystem::new(dom);
+            let mut u = |a: f64| a * (2.0 * rng.random::<f64>() - 1.0);
+            for _ in 0..n {
+                let p = Vec3::new(0.5 + u(0.49), 1.0 + u(0.99), 1.5 + u(1.4));
+                let k = sys
+                    .add_sphere(
+                        p,
+                        Vec3::new(u(3.0), u(3.0), u(3.0)),
+                        Vec3::new(u(9.0), u(9.0), u(9.0)),
+                        0.01 + u(0.005),
+                        2500.0,
+                    )
+                    .unwrap();
+                sys.spheres.force[k] = Vec3::new(u(1e3), u(1e3), u(1e3));
+                sys.spheres.torque[k] = Vec3::new(u(1.0), u(1.0), u(1.0));
+            }
+            for k in (0..n).step_by(7) {
+                sys.set_frozen(k, true).unwrap();
+            }
+            for k in (3..n).step_by(11) {
+                sys.spheres.owner[k] = 0;
+            }
+            for dt in [None, Some(0.2)] {
+                let (mut a, mut b) = (sys.spheres.clone(), sys.spheres.clone());
+                kick(&mut a, 0.1, dt.map(|t| (t, &dom)), &mut Vec::new());
+                kick_scalar(&mut b, 0.1, dt.map(|t| (t, &dom)));
+                assert!(
+                    a == b,
+                    "n = {n}, drift {dt:?}: the batched kick parts from the scalar one"
+                );
+                if dt.is_some() {
+                    let moved = (0..n).filter(|&k| a.pos[k] != sys.spheres.pos[k]).count();
+                    let wrapped = (0..n)
+                        .filter(|&k| (a.pos[k] - sys.spheres.pos[k]).norm2() > 0.5)
+                        .count();
+                    assert!(
+                        moved > n / 2 && wrapped > 0,
+                        "n = {n}: {moved} moved, {wrapped} wrapped"
+                    );
+                }
+            }
+        }
     }
 }
