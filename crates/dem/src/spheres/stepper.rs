@@ -217,7 +217,9 @@ impl<L: SphereLaw> SphereStepper<L> {
         let dom = sys.domain;
         // Opening half kick and drift: mobile spheres (frozen ones stay), then clumps (members
         // placed on them).
-        kick(&mut sys.spheres, h, Some((dt, &dom)), &mut self.mobile);
+        // Which spheres move: fixed for the step (the force hook sees the system read-only).
+        mobile_mask(&sys.spheres, &mut self.mobile);
+        kick(&mut sys.spheres, h, Some((dt, &dom)), &self.mobile);
         let c = &mut sys.clumps;
         for k in 0..c.len() {
             c.vel[k] += c.force[k] * (h / c.mass[k]);
@@ -238,7 +240,7 @@ impl<L: SphereLaw> SphereStepper<L> {
         }
         self.forces(p, law, sys, hook);
         // Closing half kick.
-        kick(&mut sys.spheres, h, None, &mut self.mobile);
+        kick(&mut sys.spheres, h, None, &self.mobile);
         let c = &mut sys.clumps;
         for k in 0..c.len() {
             c.vel[k] += c.force[k] * (h / c.mass[k]);
@@ -530,8 +532,9 @@ const PARALLEL_SPHERES: usize = 2 * SPHERE_CHUNK;
 /// A half kick of the mobile spheres (v += F h/m, ω += T h/I) and, with `drift = Some((dt,
 /// domain))`, the drift x += v dt wrapped into the box, eight spheres at a time
 /// (`super::kick_batched`, the bits of the scalar form [`kick_scalar`]). Each sphere on its own:
-/// parallel for large systems, and the same bits on any thread count. `mobile` is scratch.
-fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>, mobile: &mut Vec<f64>) {
+/// parallel for large systems, and the same bits on any thread count. `mobile` from
+/// [`mobile_mask`].
+fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>, mobile: &[f64]) {
     let Spheres {
         pos,
         vel,
@@ -540,16 +543,8 @@ fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>, 
         torque,
         mass,
         inertia,
-        owner,
-        frozen,
         ..
     } = s;
-    mobile.clear();
-    // Mobile: free (no clump) and not frozen (as `SphereSystem::is_mobile`).
-    mobile.extend((0..pos.len()).map(|k| {
-        let fixed = owner.get(k).is_some_and(|&o| o != FREE) || frozen.get(k).is_some_and(|&f| f);
-        if fixed { 0.0 } else { 1.0 }
-    }));
     let inp = KickInput {
         force,
         torque,
@@ -582,6 +577,16 @@ fn kick(s: &mut Spheres, h: f64, drift: Option<(f64, &super::domain::Domain3)>, 
                 })
             });
     }
+}
+
+/// 1.0 for each mobile sphere, free (no clump) and not frozen (as `SphereSystem::is_mobile`),
+/// else 0.0: the kick's lanes select on it.
+fn mobile_mask(s: &Spheres, out: &mut Vec<f64>) {
+    out.clear();
+    out.extend((0..s.len()).map(|k| {
+        let fixed = s.owner.get(k).is_some_and(|&o| o != FREE) || s.frozen.get(k).is_some_and(|&f| f);
+        if fixed { 0.0 } else { 1.0 }
+    }));
 }
 
 /// The kick one sphere at a time: the reference the batched kick is tested against.
@@ -815,7 +820,9 @@ mod tests {
             }
             for dt in [None, Some(0.2)] {
                 let (mut a, mut b) = (sys.spheres.clone(), sys.spheres.clone());
-                kick(&mut a, 0.1, dt.map(|t| (t, &dom)), &mut Vec::new());
+                let mut mobile = Vec::new();
+                mobile_mask(&a, &mut mobile);
+                kick(&mut a, 0.1, dt.map(|t| (t, &dom)), &mobile);
                 kick_scalar(&mut b, 0.1, dt.map(|t| (t, &dom)));
                 assert!(
                     a == b,

@@ -319,6 +319,7 @@ impl Geometry {
                     let (mut u, mut z) = (i as f64 * along, (k as f64 + 0.5) * dz);
                     if j > 0.0 {
                         u = (u + rng.random_range(-j..j) * along).clamp(0.0, len);
+                        // Drawn in a monolayer too, so a seed jitters the lines alike.
                         let shift = rng.random_range(-j..j) * dz;
                         if !self.monolayer {
                             z = (z + shift).rem_euclid(self.depth);
