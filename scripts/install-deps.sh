@@ -6,7 +6,7 @@
 set -euo pipefail
 command -v cargo >/dev/null || { echo "cargo not found: install Rust (rustup) first" >&2; exit 1; }
 rustup component list --installed 2>/dev/null | grep -q rustfmt || rustup component add rustfmt clippy 2>/dev/null || true
-# chromium: the report test (tests/su2020_ci_pipeline.rs). Open MPI (mpicc, mpirun, headers) and
+# chromium: the report test (tests/it/su2020_ci_pipeline.rs). Open MPI (mpicc, mpirun, headers) and
 # libclang (bindgen in mpi-sys): crates/mpi.
 need=()
 for p in chromium libopenmpi-dev openmpi-bin libclang-dev; do

@@ -10,7 +10,7 @@
 # Exit status: 0 when every test that ran passed.
 #
 # One line per validation below: crate | test file (or lib) | test name | figure | reference | tolerance.
-# A new ignored validation gets a line here (tests/self_contained.rs checks that every ignored
+# A new ignored validation gets a line here (tests/it/self_contained.rs checks that every ignored
 # test of the workspace is listed, or named as an exploration in EXPLORATIONS or a child process
 # in CHILDREN).
 set -euo pipefail
@@ -25,7 +25,7 @@ lbdem-coupling|settling_disk|settling_converges_with_resolution|terminal velocit
 lbdem-coupling|darcy|permeability_reference_from_fine_levels|permeability k/L² of a random packing of 14 disks (Φ = 0.30) at L = 64, 128, 256, Richardson-extrapolated|the test'"'"'s FINE_K (second order: ratio 3.87)|1e-6 (the constant it prints)
 lbdem-coupling|low_resolution|fine_lattice_reference|permeability k/d̄² of the two-circle packing at 10, 20, 40 cells, Richardson-extrapolated|the test'"'"'s FINE_K (second order)|0.5 %
 lbdem-coupling|low_resolution|fine_disk_arrays_meet_the_table|drag of disk arrays at 40 cells/d, Φ = 0.1, 0.3, 0.5|Sangani & Acrivos 1982 Table 1|0.5 %, 3 %, 15 %
-lbdem-coupling|surface_grains|a_finer_floating_grain|submerged fraction of a sphere of half the liquid's density floating in a free-surface pool, 7.5 nodes of radius|Archimedes: 0.5|± 0.005 (measured 0.4973)
+lbdem-coupling|surface_grains|a_finer_floating_grain|submerged fraction of a sphere of half the liquid'"'"'s density floating in a free-surface pool, 7.5 nodes of radius|Archimedes: 0.5|± 0.005 (measured 0.4973)
 lbdem-coupling|surface_grains|ten_cates_four_cases_at_eight_cells|terminal velocity of a settling sphere, cases E1-E4, 8 cells per diameter|ten Cate et al. 2002 Table 1|4, 2.5, 9, 12 % (measured +2.1, −1.2, −4.7, −7.0 %)
 lbdem-coupling|dkt|dkt_phases_at_finer_resolution|drafting, kissing, tumbling of two disks at 12 and 16 cells/d|Glowinski et al. 2001 set-up (phases only)|the three phases occur (test'"'"'s thresholds)
 lbdem-coupling|dkt_uhlmann|coarser_lattice_and_the_variants|DKT at 16 cells/d; without the interior-liquid correction, BGK, contact at the surfaces|Uhlmann 2005 Figs. 6a, 7a; Koblitz et al. 2017 Figs. 10a, 10c|0.1 d RMS to the kiss; tumble within the publications'"'"' times
@@ -95,9 +95,11 @@ while IFS='|' read -r crate file name figure reference tolerance; do
   t0=$(date +%s.%N)
   # file "lib": a test of the crate's library (src/**/tests), found by its name.
   # The engine crates have one test binary each (tests/main.rs, named after the crate), whose
-  # tests are <file>::<name>; the lbdem crate keeps one binary per file.
+  # tests are <file>::<name>; so has the lbdem crate (tests/it/main.rs, binary `it`), but for
+  # its fuzz harness (tests/fuzz.rs, binary `fuzz`), which installs its own global allocator.
   case "$crate" in
     lbdem-lbm | lbdem-coupling | lbdem-dem) suite=${crate#lbdem-}; full="$file::$name" ;;
+    lbdem) if [ "$file" = fuzz ]; then suite=fuzz; full=$name; else suite=it; full="$file::$name"; fi ;;
     *) suite=$file; full=$name ;;
   esac
   if [ "$file" = lib ]; then target=(--lib); exact=(); else target=(--test "$suite"); exact=(--exact); fi

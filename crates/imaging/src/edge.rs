@@ -6,7 +6,7 @@
 //! sharp solid/liquid edge reads too much solid (Jensen's inequality). Inside an assembly the
 //! bias is much the same in the reference and the deformed frame and cancels in `g0 / g`; an
 //! REV that reaches a bulk phase has a lower or steeper `g_S` and the bias, divided by it, does
-//! not cancel. Measured on synthetic radiographs (`tests/radiograph_edge_flag.rs`): the REV
+//! not cancel. Measured on synthetic radiographs (`tests/it/radiograph_edge_flag.rs`): the REV
 //! strain error reached 0.008 within one REV of the liquid pad and stayed below 0.005 elsewhere.
 //!
 //! The rule: a pixel is bulk when the mean pixel solid fraction over a window of a few grains

@@ -2,7 +2,7 @@
 //! grain size and plate rate), its replica sweep in small, and a sweep killed part way (SIGKILL)
 //! that resumes its interrupted case from the checkpoint and ends with the same table.
 
-mod common;
+use crate::common;
 use common::run;
 use lbdem::report::table;
 use polars::prelude::DataType;
@@ -321,7 +321,7 @@ fn mass_scaling_by_a_hundred_moves_no_assemblys_strain_beyond_twice_the_largest_
 /// 2.3 % of u_y (largest single band 8.4 %); the tolerances are twice the bounds. The spread of ε_vol^DEM between
 /// assemblies is 0.0037. 75 s on 2 cores.
 #[test]
-#[ignore = "75 s: cargo test --release --test sweep_cli -- --ignored mass_scaling_by_a_hundred_is"]
+#[ignore = "75 s: cargo test --release --test it -- --ignored sweep_cli::mass_scaling_by_a_hundred_is"]
 fn mass_scaling_by_a_hundred_is_within_the_stated_tolerance_over_sixteen_assemblies() {
     let s = mass_scaling_pairs(16);
     let (me, se) = mean_se(&s.iter().map(|x| x.eps_vol).collect::<Vec<_>>());

@@ -7,9 +7,9 @@
 //! any material region is J = det(I + H), which is what Eq. 5 measures when the grains keep their
 //! area. The test asserts each operator against them, with tolerances twice the errors measured.
 
-use std::path::{Path, PathBuf};
-mod common;
+use crate::common;
 use common::run;
+use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

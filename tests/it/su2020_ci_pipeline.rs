@@ -7,9 +7,9 @@
 //! What a 300-grain cell moved by one diameter can show is asserted; the paper's own numbers
 //! need the full runs (pipelines/su2020.toml, docs/analysis.md).
 
-use std::path::{Path, PathBuf};
-mod common;
+use crate::common;
 use common::run;
+use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -3,9 +3,9 @@
 //! reruns them with `--force`. The pipeline is copied with its output redirected to a
 //! temporary directory so the test never writes into the repository.
 
-use std::path::{Path, PathBuf};
-mod common;
+use crate::common;
 use common::run;
+use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -1,6 +1,6 @@
 //! Bad input gets a clear error that names the file or parameter, and nothing is written.
 
-mod common;
+use crate::common;
 
 use lbdem::contract::{Stage, StageContext};
 use lbdem::io::tiff::{write_u8, write_u16};

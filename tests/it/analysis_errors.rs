@@ -1,9 +1,9 @@
 //! The analysis stages refuse bad input with a message that names the problem and the fix, and a
 //! refused stage leaves no output directory behind.
 
-use std::path::{Path, PathBuf};
-mod common;
+use crate::common;
 use common::run;
+use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -1,7 +1,7 @@
 //! Bad pipeline files fail with the file and the offending name in the message, before
 //! anything is written.
 
-mod common;
+use crate::common;
 use common::run;
 
 #[test]

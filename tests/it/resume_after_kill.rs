@@ -3,7 +3,7 @@
 //! every kind of scene: grains only, liquid only, and grains in a liquid. The kill lands right
 //! after the first checkpoint is written; the test fails if the run had already finished.
 
-mod common;
+use crate::common;
 use common::run;
 use std::path::Path;
 use std::process::Command;

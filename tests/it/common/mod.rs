@@ -1,7 +1,5 @@
 //! Helpers shared by the integration tests that drive the real `lbdem` binary.
 
-#![allow(dead_code)] // each test binary uses its own subset
-
 use std::path::Path;
 use std::process::Command;
 

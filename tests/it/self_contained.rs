@@ -102,3 +102,52 @@ fn every_ignored_test_is_listed_in_the_validation_script() {
         "ignored tests not in scripts/validate-all.sh (add a line: crate|file|name|figure|reference|tolerance): {missing:?}"
     );
 }
+
+/// The scripts the docs quote must at least parse: an unescaped apostrophe in the validation
+/// table (`liquid's` inside a single-quoted string) once broke `validate-all.sh` for every use,
+/// `--help` included, and no test noticed. `--list` reads the whole table without running it.
+#[test]
+fn the_scripts_parse_and_the_validation_table_lists() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut scripts: Vec<PathBuf> = std::fs::read_dir(root.join("scripts"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "sh"))
+        .collect();
+    scripts.push(root.join(".ci/run"));
+    assert!(scripts.len() >= 5, "found only {scripts:?}");
+    for s in &scripts {
+        let o = std::process::Command::new("bash")
+            .arg("-n")
+            .arg(s)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{}: {}",
+            s.display(),
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let o = std::process::Command::new("bash")
+        .arg(root.join("scripts/validate-all.sh"))
+        .arg("--list")
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "validate-all.sh --list: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let table = String::from_utf8_lossy(&o.stdout);
+    for id in [
+        "lbdem-lbm/cavity/re1000_matches_ghia",
+        "lbdem/sweep_cli/mass_scaling_by_a_hundred",
+    ] {
+        assert!(
+            table.contains(id),
+            "validate-all.sh --list does not list {id}:\n{table}"
+        );
+    }
+}
