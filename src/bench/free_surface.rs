@@ -22,6 +22,7 @@ const BINGHAM: Bingham = Bingham {
     rho: 1.0,
     tau_min: 0.501,
     tau_max: 3.5,
+    smagorinsky: 0.0,
 };
 
 fn collision() -> Collision {

@@ -447,6 +447,7 @@ fn a_few_pebbles_ride_a_spreading_bingham_paste() {
             rho: 1.0,
             tau_min: 0.55,
             tau_max: 3.5,
+            smagorinsky: 0.0,
         }))
         .expect("set Bingham");
     let frame = BodyFrame::of(&ClumpTemplate::tetrahedron(2.2, 3.4), 2.0, DEFAULT_NODES).expect("pebble");

@@ -26,6 +26,7 @@ fn mlups(n: [usize; 3], bingham: bool) -> Result<f64, Box<dyn std::error::Error>
             rho: 1.0,
             tau_min: 0.501,
             tau_max: 3.5,
+            smagorinsky: 0.0,
         }))?;
     }
     let mut best = f64::INFINITY;

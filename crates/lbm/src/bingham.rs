@@ -37,6 +37,15 @@
 //! 3.5 ([`TAU_MIN_LEONARDI`], [`TAU_MAX_LEONARDI`]). The regularisation error of the plug is
 //! worked out in `docs/bingham.md` and measured in `tests/bingham.rs`.
 //!
+//! **A subgrid eddy viscosity (optional, not in the paper).** With a Smagorinsky constant C > 0
+//! the apparent viscosity gains ν_t = C² γ̇ (filter width one lattice spacing; Hou et al. 1996,
+//! the form FluidX3D and waLBerla use), which raises τ only where the shear rate is large, as at a
+//! spreading front, where coarse lattices at τ ≈ ½ break down (docs/free_surface.md, "The
+//! incline"). The pair is still solved in closed form: Eq. 30 becomes
+//! τ = τ_pl + 2σ_y τ/P + 9C²P/(2ρτ), a quadratic a τ² − τ_pl τ − k = 0 with a = 1 − 2σ_y/P and
+//! k = 9C²P/(2ρ), whose positive root gives ω = 2a / (τ_pl + √(τ_pl² + 4ak)) (0, so τ_max, for
+//! a ≤ 0: unyielded), then the clamp. With C = 0 the kernel takes the path above, bit for bit.
+//!
 //! BGK (Leonardi Eq. 11) relaxes every moment with the local ω; TRT takes ω⁺ = ω and ω⁻ from its
 //! magic parameter Λ per node, ω⁻ = 2(2 − ω) / (2 − ω + 4Λω) (from τ⁻ = ½ + Λ/(τ⁺ − ½)).
 
@@ -69,6 +78,10 @@ pub struct Bingham {
     pub tau_min: f64,
     /// Largest relaxation time: the viscosity of the unyielded region (> τ_min and > τ_pl).
     pub tau_max: f64,
+    /// Smagorinsky constant C of the optional eddy viscosity ν_t = C² γ̇ (module doc; ≥ 0, 0 is
+    /// the paper's model). Not in Leonardi et al.: a coarse-lattice option, typically 0.1-0.2.
+    #[serde(default)]
+    pub smagorinsky: f64,
 }
 
 impl Bingham {
@@ -80,6 +93,7 @@ impl Bingham {
             rho,
             tau_min: TAU_MIN_LEONARDI,
             tau_max: TAU_MAX_LEONARDI,
+            smagorinsky: 0.0,
         };
         b.check()?;
         Ok(b)
@@ -98,7 +112,8 @@ impl Bingham {
     /// The clamped relaxation time for a shear rate γ̇ (Leonardi Eq. 30 with the clamp of Fig. 4):
     /// the constitutive law the kernel applies, in f64, for tests and for analytic profiles.
     pub fn tau_of_shear_rate(&self, shear_rate: f64) -> f64 {
-        let t = 0.5 + 3.0 * (self.nu_pl() + self.yield_stress / (self.rho * shear_rate));
+        let nu_t = self.smagorinsky * self.smagorinsky * shear_rate;
+        let t = 0.5 + 3.0 * (self.nu_pl() + self.yield_stress / (self.rho * shear_rate) + nu_t);
         if t.is_nan() || t > self.tau_max {
             self.tau_max
         } else {
@@ -156,6 +171,14 @@ impl Bingham {
                 ),
             );
         }
+        if !(self.smagorinsky.is_finite() && self.smagorinsky >= 0.0) {
+            return bad(
+                "smagorinsky",
+                self.smagorinsky,
+                "the Smagorinsky constant must be finite and >= 0 (0: no eddy viscosity, the \
+                 paper's model); 0.1-0.2 is usual",
+            );
+        }
         let tau_pl = self.tau_pl();
         if tau_pl >= self.tau_max {
             return bad(
@@ -188,6 +211,11 @@ pub struct BinghamRates<T> {
     /// 1/τ_max and 1/τ_min.
     pub omega_lo: T,
     pub omega_hi: T,
+    /// The eddy viscosity (module doc): whether on, τ_pl, 2σ_y and 9C²/2.
+    pub eddy: bool,
+    pub tau_pl: T,
+    pub two_yield: T,
+    pub smag_term: T,
     /// Where to write τ per node (the stepper's `bingham_tau`), if asked for this step.
     pub tau: Option<SyncPtr<f64>>,
 }
@@ -215,6 +243,10 @@ impl<T: Real> BinghamRates<T> {
             yield_term: T::from_f64(2.0 * bingham.yield_stress * omega_pl),
             omega_lo: T::from_f64(1.0 / bingham.tau_max),
             omega_hi: T::from_f64(1.0 / bingham.tau_min),
+            eddy: bingham.smagorinsky > 0.0,
+            tau_pl: T::from_f64(bingham.tau_pl()),
+            two_yield: T::from_f64(2.0 * bingham.yield_stress),
+            smag_term: T::from_f64(4.5 * bingham.smagorinsky * bingham.smagorinsky),
             tau: None,
         })
     }
@@ -282,7 +314,17 @@ impl<T: Real> BinghamRates<T> {
         let mut om = [zero; W];
         for w in 0..W {
             let q = if p2[w] < floor { floor } else { p2[w] };
-            let o = self.omega_pl - self.yield_term / q.sqrt();
+            let o = if self.eddy {
+                // a τ² − τ_pl τ − k = 0 (module doc); a ≤ 0 (unyielded) gives ω = 0, so τ_max
+                let p = q.sqrt();
+                let a = T::from_f64(1.0) - self.two_yield / p;
+                let a = if a < zero { zero } else { a };
+                let k = self.smag_term * p / m.rho[w];
+                let disc = (T::from_f64(4.0) * a).mul_add(k, self.tau_pl * self.tau_pl);
+                two * a / (self.tau_pl + disc.sqrt())
+            } else {
+                self.omega_pl - self.yield_term / q.sqrt()
+            };
             om[w] = if o < self.omega_lo {
                 self.omega_lo
             } else if o > self.omega_hi {

@@ -132,6 +132,7 @@ pub fn map(p: &Params) -> Result<Vec<Point>> {
                 tau_max,
                 y0_frac: plug,
                 u_p: p.u_p,
+                smagorinsky: 0.0,
             };
             let verdict = verdict(&case, operator);
             let what = |e| {

@@ -117,6 +117,7 @@ pub fn map(p: &Params) -> Result<Vec<Point>> {
                 tau_max: p.tau_max,
                 y0_frac: p.plug,
                 u_p: p.u_p,
+                smagorinsky: 0.0,
             };
             let what = |e| {
                 anyhow!(

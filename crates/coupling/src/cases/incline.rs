@@ -60,6 +60,14 @@ pub struct InclineSpec {
     pub rho_paste: f64,
     pub tau_min: f64,
     pub tau_max: f64,
+    /// Smagorinsky constant of an eddy viscosity on top of the Bingham law (`Bingham::
+    /// smagorinsky`; not in the paper, 0 is its model): what lets a coarse lattice carry the front.
+    #[serde(default)]
+    pub smagorinsky: f64,
+    /// Lonely-node threshold of the free surface (`FreeSurfaceParams::lonely`; not in the paper,
+    /// 0 is its rules): empties thin films and falling sheets one node thick.
+    #[serde(default)]
+    pub lonely: f64,
     /// Pebbles: count, radius range (m), density (kg/m³), placement seed.
     pub pebbles: usize,
     pub r_min: f64,
@@ -119,6 +127,8 @@ impl InclineSpec {
             rho_paste: 1800.0,
             tau_min: 0.501,
             tau_max: 3.5,
+            smagorinsky: 0.0,
+            lonely: 0.0,
             pebbles: 1000,
             r_min: 4e-3,
             r_max: 8e-3,
@@ -161,6 +171,7 @@ impl InclineSpec {
             rho: 1.0,
             tau_min: self.tau_min,
             tau_max: self.tau_max,
+            smagorinsky: self.smagorinsky,
         }
     }
 
@@ -276,7 +287,14 @@ impl Incline {
             force: [g_lu.x, g_lu.y, g_lu.z],
             limits: Limits::default(),
         };
-        let mut stepper = FreeSurfaceStepper::new(&liquid, settings, FreeSurfaceParams::default())?;
+        let mut stepper = FreeSurfaceStepper::new(
+            &liquid,
+            settings,
+            FreeSurfaceParams {
+                lonely: spec.lonely,
+                ..FreeSurfaceParams::default()
+            },
+        )?;
         stepper.set_bingham(Some(bingham))?;
         stepper.record_tau(true, liquid.nodes());
         let scale = SurfaceScale {

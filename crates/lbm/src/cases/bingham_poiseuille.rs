@@ -19,6 +19,8 @@ pub struct Case {
     pub tau_max: f64,
     pub y0_frac: f64,
     pub u_p: f64,
+    /// Smagorinsky constant of the eddy viscosity (`Bingham::smagorinsky`; 0: none).
+    pub smagorinsky: f64,
 }
 
 impl Case {
@@ -45,6 +47,7 @@ impl Case {
             rho: 1.0,
             tau_min: self.tau_min,
             tau_max: self.tau_max,
+            smagorinsky: self.smagorinsky,
         }
     }
     /// Distance of row y from the channel centre (walls at y = −½ and h_nodes − ½).
@@ -56,6 +59,28 @@ impl Case {
         let (h, y0, g, mu) = (self.h(), self.y0(), self.g(), self.mu_pl());
         let a = y.abs().max(y0);
         g * ((h * h - a * a) - 2.0 * y0 * (h - a)) / (2.0 * mu)
+    }
+    /// The analytic profile of a Newtonian fluid (σ_y = 0) with the eddy viscosity ν_t = C² γ̇
+    /// of `Bingham::smagorinsky`, unclamped: the shear stress G|y| = ρ (ν_pl + C² s) s with
+    /// s = |du/dy| gives s(t) = (√(ν_pl² + 4C²G t) − ν_pl) / (2C²) (ρ = 1), and
+    /// u(y) = ∫_|y|^h s dt = [((ν_pl² + 4C²Gh)^{3/2} − (ν_pl² + 4C²G|y|)^{3/2}) / (6C²G)
+    /// − ν_pl (h − |y|)] / (2C²); the Newtonian parabola when C = 0.
+    pub fn smagorinsky_u(&self, y: f64) -> f64 {
+        let (h, g, nu, c2) = (self.h(), self.g(), self.mu_pl(), self.smagorinsky.powi(2));
+        let a = y.abs();
+        if c2 == 0.0 {
+            return g * (h * h - a * a) / (2.0 * nu);
+        }
+        let p = |t: f64| (nu * nu + 4.0 * c2 * g * t).powf(1.5);
+        ((p(h) - p(a)) / (6.0 * c2 * g) - nu * (h - a)) / (2.0 * c2)
+    }
+    /// The shear rate of [`Self::smagorinsky_u`] at distance `y` from the centre.
+    pub fn smagorinsky_rate(&self, y: f64) -> f64 {
+        let (g, nu, c2) = (self.g(), self.mu_pl(), self.smagorinsky.powi(2));
+        if c2 == 0.0 {
+            return g * y.abs() / nu;
+        }
+        ((nu * nu + 4.0 * c2 * g * y.abs()).sqrt() - nu) / (2.0 * c2)
     }
     /// Exact profile of the clamped law (Fig. 4): u(y) = ∫_|y|^h γ̇(G s) ds with γ̇(σ) = σ/μ_max
     /// below σ_c = σ_y μ_max/(μ_max − μ_pl), (σ − σ_y)/μ_pl above it, σ/μ_min above

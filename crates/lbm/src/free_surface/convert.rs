@@ -7,7 +7,13 @@
 //! one node, left behind by a splash) is emptied whatever its mass: alone it cannot move (mass
 //! only crosses links to liquid and interface nodes) while gravity keeps accelerating its
 //! populations, so it would stop the run at the Mach limit (seen in the dam break before this
-//! rule). Then, in this order, sequentially in node order (deterministic):
+//! rule). **Lonely nodes** (optional, a threshold θ > 0; Thürey 2007, as OpenLB and waLBerla
+//! have it): an interface node with no liquid neighbour is emptied already below m = θρ, and one
+//! with no gas neighbour filled above m = (1 − θ)ρ. A film or a falling sheet one node thick is
+//! made of interface nodes only; mass crosses between them in proportion to their fills, so a node
+//! drained to a small fill keeps its populations, and gravity goes on accelerating them until the
+//! Mach limit (the incline's coarse lattices, docs/free_surface.md). Then, in this order,
+//! sequentially in node order (deterministic):
 //! 1. every gas neighbour of a filled node becomes a new interface node (m = 0) with the
 //!    populations at the equilibrium of the mean (ρ, u) of its liquid and interface neighbours
 //!    (Leonardi Eq. 13; Sect. 5.1 initialises nodes uncovered by grains the same way); an interface
@@ -69,6 +75,7 @@ pub fn convert<L: Lattice>(
     s: &mut FreeSurface<L>,
     links: &[u32],
     kappa: f64,
+    lonely: f64,
     scratch: &mut ConvertScratch,
 ) -> Conversions {
     let n = s.nodes();
@@ -83,10 +90,16 @@ pub fn convert<L: Lattice>(
             continue;
         }
         let isolated = !nbrs::<L>(links, n, x).any(|j| matches!(s.cell[j], LIQUID | INTERFACE));
-        if s.mass[x] > (1.0 + kappa) * s.rho[x] {
+        let (mut fill_lonely, mut empty_lonely) = (false, false);
+        if lonely > 0.0 {
+            let (m, rho) = (s.mass[x], s.rho[x]);
+            fill_lonely = m > (1.0 - lonely) * rho && !nbrs::<L>(links, n, x).any(|j| s.cell[j] == GAS);
+            empty_lonely = m < lonely * rho && !nbrs::<L>(links, n, x).any(|j| s.cell[j] == LIQUID);
+        }
+        if s.mass[x] > (1.0 + kappa) * s.rho[x] || fill_lonely {
             sc.filled.push(x);
             sc.flag[x] = FILL;
-        } else if s.mass[x] < -kappa * s.rho[x] || isolated {
+        } else if s.mass[x] < -kappa * s.rho[x] || isolated || empty_lonely {
             sc.emptied.push(x);
             sc.flag[x] = EMPTY;
         }

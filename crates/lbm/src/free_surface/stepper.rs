@@ -37,6 +37,11 @@ pub struct FreeSurfaceParams {
     /// Conversion margin κ (module `convert`): interface nodes fill at m > (1 + κ)ρ and empty
     /// at m < −κρ. Körner et al. (2005) use 1e-3.
     pub kappa: f64,
+    /// Lonely-node threshold θ (module `convert`; 0: off, the paper's rules): an interface node
+    /// with no liquid neighbour empties below m = θρ, one with no gas neighbour fills above
+    /// m = (1 − θ)ρ. Thürey (2007) uses 0.1.
+    #[serde(default)]
+    pub lonely: f64,
 }
 
 impl Default for FreeSurfaceParams {
@@ -44,6 +49,7 @@ impl Default for FreeSurfaceParams {
         Self {
             rho_atm: 1.0,
             kappa: 1e-3,
+            lonely: 0.0,
         }
     }
 }
@@ -83,6 +89,12 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
             return Err(LbmError::FreeSurface(format!(
                 "conversion margin kappa = {} must be in [0, 0.1); Körner et al. (2005) use 1e-3",
                 params.kappa
+            )));
+        }
+        if !(params.lonely.is_finite() && (0.0..=1.0).contains(&params.lonely)) {
+            return Err(LbmError::FreeSurface(format!(
+                "lonely-node threshold lonely = {} must be in [0, 1]; 0 is off, Thürey (2007) uses 0.1",
+                params.lonely
             )));
         }
         let dom = &s.domain;
@@ -207,7 +219,13 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
         if let Some(x) = bad {
             return Err(self.diagnose(s, x));
         }
-        Ok(convert(s, &self.links, self.params.kappa, &mut self.scratch))
+        Ok(convert(
+            s,
+            &self.links,
+            self.params.kappa,
+            self.params.lonely,
+            &mut self.scratch,
+        ))
     }
 
     /// The failure at node `x`, named (issue 20 item 6): the engine's cause (τ near ½, Mach,
