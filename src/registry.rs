@@ -66,6 +66,7 @@ pub static STAGES: &[StageKind] = &[
     entry::<stages::synth_run::SynthRun>(&["synth", "run"], CliShape::ParamsFile),
     entry::<stages::compare::Compare>(&["compare"], CliShape::ParamsFile),
     entry::<stages::mechanism_map::MechanismMap>(&["mechanism-map"], CliShape::ParamsFile),
+    entry::<stages::incline_outlines::InclineOutlines>(&["incline-outlines"], CliShape::ParamsFile),
     entry::<stages::matrix::Matrix>(&["matrix"], CliShape::ParamsFile),
     entry::<stages::tradeoffs::Tradeoffs>(&["tradeoffs"], CliShape::ParamsFile),
     entry::<stages::minimal_models::MinimalModels>(&["minimal-models"], CliShape::ParamsFile),

@@ -8,6 +8,7 @@ pub mod assemble;
 pub mod compare;
 pub mod digitise;
 pub mod extrusion;
+pub mod incline_outlines;
 pub mod matrix;
 pub mod mechanism_map;
 pub mod minimal_models;

@@ -3,7 +3,8 @@
 //! steps and at every step where it exceeds 0.2 (lattice units), with its cell type, fill, ρ and τ.
 //!   cargo run --release -p lbdem-coupling --example incline_probe --features probes -- C THETA F
 //! C: Smagorinsky constant, THETA: lonely-node threshold, F: coarsening factor of the paper's
-//! 2 mm lattice (5: 10 mm). docs/free_surface.md, "The incline", has what it found.
+//! 2 mm lattice (5: 10 mm), optionally DT: the LBM step (s) instead of the diffusive F² x 3e-5.
+//! MAGIC=Λ in the environment runs TRT with that magic parameter instead of BGK. docs/free_surface.md, "The incline", has what it found.
 use lbdem_coupling::cases::incline::{Incline, InclineSpec};
 use lbdem_lbm::free_surface::{INTERFACE, LIQUID};
 
@@ -14,7 +15,27 @@ fn main() {
     spec.pebbles = 0;
     spec.substeps = 30;
     spec.smagorinsky = args.first().copied().unwrap_or(0.0);
+    if let Some(&dt) = args.get(3) {
+        // another time step: substeps keep the DEM step
+        spec.substeps = ((spec.substeps as f64) * dt / spec.dt).ceil().max(1.0) as u32;
+        spec.dt = dt;
+    }
     spec.lonely = args.get(1).copied().unwrap_or(0.0);
+    spec.magic = std::env::var("MAGIC")
+        .ok()
+        .and_then(|m| m.parse().ok())
+        .unwrap_or(0.0);
+    let b = spec.bingham();
+    println!(
+        "dx {} dt {} tau_pl {:.6} (clamp [{}, {}]) smagorinsky {} lonely {}",
+        spec.dx,
+        spec.dt,
+        b.tau_pl(),
+        b.tau_min,
+        b.tau_max,
+        spec.smagorinsky,
+        spec.lonely
+    );
     let mut inc = Incline::build(&spec).unwrap();
     let n = spec.nodes();
     for step in 0..200000 {
