@@ -38,8 +38,7 @@
 //! worked out in `docs/bingham.md` and measured in `tests/bingham.rs`.
 //!
 //! **A subgrid eddy viscosity (optional, not in the paper).** With a Smagorinsky constant C > 0
-//! the apparent viscosity gains ν_t = C² γ̇ (filter width one lattice spacing; Hou et al. 1996,
-//! the form FluidX3D and waLBerla use), which raises τ only where the shear rate is large, as at a
+//! the apparent viscosity gains ν_t = C² γ̇ (filter width one lattice spacing; Hou et al. 1996), which raises τ only where the shear rate is large, as at a
 //! spreading front, where coarse lattices at τ ≈ ½ break down (docs/free_surface.md, "The
 //! incline"). The pair is still solved in closed form: Eq. 30 becomes
 //! τ = τ_pl + 2σ_y τ/P + 9C²P/(2ρτ), a quadratic a τ² − τ_pl τ − k = 0 with a = 1 − 2σ_y/P and

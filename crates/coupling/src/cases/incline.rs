@@ -68,9 +68,10 @@ pub struct InclineSpec {
     /// 0 is its rules): empties thin films and falling sheets one node thick.
     #[serde(default)]
     pub lonely: f64,
-    /// TRT magic parameter Λ of the paste's collision; 0 (default) is the paper's BGK. With BGK a
-    /// halfway bounce-back wall slips in proportion to (τ − ½)², so the unyielded paste (τ_max)
-    /// creeps down the board; TRT with Λ = 3/16 puts the wall halfway for every τ.
+    /// TRT magic parameter Λ of the paste's collision; 0 (default) is the paper's BGK, whose
+    /// halfway bounce-back wall moves with τ (far at τ_max = 3.5); TRT with Λ = 3/16 keeps it
+    /// halfway for every τ. At 10 mm it changed neither the stability nor the footprint
+    /// (docs/free_surface.md, "The incline").
     #[serde(default)]
     pub magic: f64,
     /// Pebbles: count, radius range (m), density (kg/m³), placement seed.

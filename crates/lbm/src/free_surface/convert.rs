@@ -7,8 +7,7 @@
 //! one node, left behind by a splash) is emptied whatever its mass: alone it cannot move (mass
 //! only crosses links to liquid and interface nodes) while gravity keeps accelerating its
 //! populations, so it would stop the run at the Mach limit (seen in the dam break before this
-//! rule). **Lonely nodes** (optional, a threshold θ > 0; Thürey 2007, as OpenLB and waLBerla
-//! have it): an interface node with no liquid neighbour is emptied already below m = θρ, and one
+//! rule). **Lonely nodes** (optional, a threshold θ > 0; Thürey 2007, as OpenLB has it): an interface node with no liquid neighbour is emptied already below m = θρ, and one
 //! with no gas neighbour filled above m = (1 − θ)ρ. A film or a falling sheet one node thick is
 //! made of interface nodes only; mass crosses between them in proportion to their fills, so a node
 //! drained to a small fill keeps its populations, and gravity goes on accelerating them until the

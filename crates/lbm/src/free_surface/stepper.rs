@@ -39,7 +39,7 @@ pub struct FreeSurfaceParams {
     pub kappa: f64,
     /// Lonely-node threshold θ (module `convert`; 0: off, the paper's rules): an interface node
     /// with no liquid neighbour empties below m = θρ, one with no gas neighbour fills above
-    /// m = (1 − θ)ρ. Thürey (2007) uses 0.1.
+    /// m = (1 − θ)ρ (Thürey 2007; OpenLB's LONELY_THRESHOLD). The coarse inclines use 1.
     #[serde(default)]
     pub lonely: f64,
 }
@@ -93,7 +93,7 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
         }
         if !(params.lonely.is_finite() && (0.0..=1.0).contains(&params.lonely)) {
             return Err(LbmError::FreeSurface(format!(
-                "lonely-node threshold lonely = {} must be in [0, 1]; 0 is off, Thürey (2007) uses 0.1",
+                "lonely-node threshold lonely = {} must be in [0, 1]; 0 is off (the paper's rules), the coarse inclines use 1",
                 params.lonely
             )));
         }
