@@ -62,6 +62,7 @@ fn su2020_pipelines_name_existing_scenes_and_earlier_stages() {
     for f in [
         "pipelines/su2020.toml",
         "pipelines/su2020-ci.toml",
+        "pipelines/su2020-quick.toml",
         "pipelines/su2020-fig11-2150um.toml",
         "pipelines/quickstart.toml",
     ] {
