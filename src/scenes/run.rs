@@ -177,12 +177,18 @@ pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResul
         if let Some(why) = ending.stopped.as_ref().filter(|_| !crate::contract::quiet()) {
             eprintln!("{}: {why}; stopping", l.name);
         }
+        let warnings = m.warnings();
+        if !crate::contract::quiet() {
+            for w in &warnings {
+                eprintln!("{}: warning: {w}", l.name);
+            }
+        }
         let mut files = Vec::new();
         let mut summary = serde_json::json!({
             "scene": l.name, "physics": l.physics, "steps": ending.steps, "time": ending.time,
             "stopped": ending.stopped, "wall_seconds": ending.wall_s, "resumed_from": ending.resumed_from,
             "steps_per_second": ending.steps as f64 / ending.wall_s.max(1e-12),
-            "engine": m.describe(), "simplified": l.simplified,
+            "engine": m.describe(), "simplified": l.simplified, "warnings": warnings,
         });
         for o in &obs {
             let (f, entry) = o.report(m.as_ref());

@@ -54,6 +54,11 @@ pub trait Model {
     fn describe(&self) -> serde_json::Value {
         serde_json::Value::Null
     }
+    /// Accuracy failures the run measured without stopping (e.g. a Bingham paste creeping at
+    /// its clamp), each naming the fix: printed after the run and kept in its summary.
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// Whether the state can be saved now (the in-place LBM kernel only after even steps).
     fn can_checkpoint(&self) -> bool {
         true

@@ -56,13 +56,14 @@ fn node_grid(na: usize, nb: usize, dx: f64) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// The series columns after `time`.
-pub const COLUMNS: [&str; 6] = [
+pub const COLUMNS: [&str; 7] = [
     "lifted",
     "runout",
     "width",
     "rigid_share",
     "mass_drift",
     "max_pebble_speed",
+    "creep",
 ];
 
 impl Model for InclineModel {
@@ -95,6 +96,7 @@ impl Model for InclineModel {
             self.run.rigid_share(),
             (mass - self.mass0) / self.mass0,
             self.run.max_pebble_speed(),
+            self.run.creep().0,
         ]
     }
     fn probe(&self, q: Probe) -> Option<f64> {
@@ -141,6 +143,9 @@ impl Model for InclineModel {
             runout,
             100.0 * self.run.rigid_share()
         ))
+    }
+    fn warnings(&self) -> Vec<String> {
+        self.run.creep().1.into_iter().collect()
     }
     fn describe(&self) -> serde_json::Value {
         serde_json::json!({

@@ -30,7 +30,7 @@ use lbdem_dem::spheres::{
 };
 use lbdem_dem::vector::{Vec3, Vector};
 use lbdem_lbm::free_surface::{
-    Conversions, FreeSurface, FreeSurfaceParams, FreeSurfaceStepper, INTERFACE, LIQUID,
+    ClampCreep, Conversions, FreeSurface, FreeSurfaceParams, FreeSurfaceStepper, INTERFACE, LIQUID,
 };
 use lbdem_lbm::{Bingham, Collision, D3Q19, Domain, Face, Limits, Settings};
 use nalgebra::UnitQuaternion;
@@ -110,7 +110,14 @@ pub struct InclineState {
     pub grains: crate::surface_grains::SurfaceGrainsState,
     pub system: SphereSystem,
     pub lifted: f64,
+    /// The creep monitor of the paste at τ_max (absent in checkpoints written before it).
+    #[serde(default)]
+    pub creep: Option<ClampCreep>,
 }
+
+/// LBM steps per window of the creep monitor (`lbdem_lbm::free_surface::ClampCreep`): 3 ms at the
+/// paper's Δt, long against the surface's ripples, short against the slump.
+pub const CREEP_WINDOW: u64 = 100;
 
 impl InclineSpec {
     /// Leonardi et al. (2014) Sect. 6 (the project's reproduction list): lattice 350 × 80 × 250 at
@@ -311,6 +318,7 @@ impl Incline {
         )?;
         stepper.set_bingham(Some(bingham))?;
         stepper.record_tau(true, liquid.nodes());
+        stepper.monitor_creep(Some(CREEP_WINDOW), liquid.nodes());
         let scale = SurfaceScale {
             dx,
             dt,
@@ -410,6 +418,7 @@ impl Incline {
             grains: self.run.grains.state(),
             system: self.run.sys.clone(),
             lifted: self.lifted,
+            creep: self.run.grains.stepper().creep().cloned(),
         }
     }
 
@@ -423,6 +432,9 @@ impl Incline {
             )));
         }
         self.run.grains.set_state(state.grains)?;
+        if let Some(c) = state.creep {
+            self.run.grains.stepper_mut().restore_creep(c);
+        }
         self.run.sys = state.system;
         self.run.dem = lbdem_dem::spheres::SphereStepper::new();
         self.lifted = state.lifted;
@@ -465,6 +477,14 @@ impl Incline {
     /// Physical time (s).
     pub fn time(&self) -> f64 {
         self.run.grains.liquid.step as f64 * self.spec.dt
+    }
+
+    /// The share of the paste's volume that moved while at least 95 % of it sat at τ_max (the
+    /// creep at the Bingham clamp, `ClampCreep::moved`), and the failure named when above its
+    /// limit.
+    pub fn creep(&self) -> (f64, Option<String>) {
+        let st = self.run.grains.stepper();
+        (st.creep().map_or(0.0, |c| c.moved), st.creep_warning())
     }
 
     /// Share of the paste's nodes (liquid and interface) whose relaxation time is at τ_max: the

@@ -9,6 +9,7 @@
 pub mod cases;
 pub mod cells;
 pub mod convert;
+pub mod creep;
 pub mod mass;
 pub mod reconstruct;
 pub mod solids;
@@ -16,5 +17,6 @@ pub mod stepper;
 
 pub use cells::{FreeSurface, GAS, GRAIN, INTERFACE, LIQUID, WALL};
 pub use convert::Conversions;
+pub use creep::ClampCreep;
 pub use solids::{Exchanged, cover, uncover};
 pub use stepper::{FreeSurfaceParams, FreeSurfaceStepper};

@@ -11,6 +11,7 @@
 
 use super::cells::{FreeSurface, GAS, GRAIN, INTERFACE, LIQUID, WALL};
 use super::convert::{Conversions, ConvertScratch, convert};
+use super::creep::ClampCreep;
 use super::mass::{link_exchange, link_weight};
 use super::reconstruct::{atmosphere, from_gas};
 use crate::LbmError;
@@ -69,6 +70,8 @@ pub struct FreeSurfaceStepper<L: Lattice> {
     scratch: ConvertScratch,
     /// τ of the last Bingham collision per node, when recording (`record_tau`).
     tau: Option<Vec<f64>>,
+    /// The creep of the paste at τ_max (`monitor_creep`).
+    creep: Option<ClampCreep>,
     _l: PhantomData<L>,
 }
 
@@ -143,6 +146,7 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
             u_new: vec![[0.0; 3]; n],
             scratch: ConvertScratch::default(),
             tau: None,
+            creep: None,
             _l: PhantomData,
         })
     }
@@ -171,6 +175,34 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
     /// failure diagnosis reads it); `false` stops it.
     pub fn record_tau(&mut self, on: bool, nodes: usize) {
         self.tau = on.then(|| vec![f64::NAN; nodes]);
+    }
+
+    /// Measure the creep of the paste held at τ_max every `every` steps of a Bingham run
+    /// ([`ClampCreep`]: the Bingham clamp at low shear rate, an accuracy failure no blow-up
+    /// shows); `None` stops it. Starts τ recording (the monitor reads it).
+    pub fn monitor_creep(&mut self, every: Option<u64>, nodes: usize) {
+        self.creep = every.map(ClampCreep::new);
+        if every.is_some() && self.tau.is_none() {
+            self.tau = Some(vec![f64::NAN; nodes]);
+        }
+    }
+
+    /// The creep monitor, if on (for the series, the checkpoint and the end-of-run warning).
+    pub fn creep(&self) -> Option<&ClampCreep> {
+        self.creep.as_ref()
+    }
+
+    /// Put back a monitor's state from a checkpoint (kept off when the monitor is off).
+    pub fn restore_creep(&mut self, state: ClampCreep) {
+        if self.creep.is_some() {
+            self.creep = Some(state);
+        }
+    }
+
+    /// The creep of the paste at τ_max named, when it passed [`super::creep::CREEP_LIMIT`].
+    pub fn creep_warning(&self) -> Option<String> {
+        let b = self.bingham.as_ref()?;
+        self.creep.as_ref()?.warning(1.0 / b.omega_lo)
     }
 
     /// τ per node of the last step (NaN where no Bingham collision ran since recording began),
@@ -219,13 +251,25 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
         if let Some(x) = bad {
             return Err(self.diagnose(s, x));
         }
-        Ok(convert(
+        let conversions = convert(
             s,
             &self.links,
             self.params.kappa,
             self.params.lonely,
             &mut self.scratch,
-        ))
+        );
+        if let (Some(c), Some(b), Some(t)) = (self.creep.as_mut(), &bingham, &self.tau)
+            && s.step.is_multiple_of(c.every)
+            && t.len() == s.nodes()
+        {
+            c.sample(
+                |x| matches!(s.cell[x], LIQUID | INTERFACE),
+                |x| s.fill(x),
+                t,
+                1.0 / b.omega_lo,
+            );
+        }
+        Ok(conversions)
     }
 
     /// The failure at node `x`, named (issue 20 item 6): the engine's cause (τ near ½, Mach,
