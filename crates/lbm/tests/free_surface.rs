@@ -545,3 +545,86 @@ fn a_column_creeping_at_the_bingham_ceiling_is_named() {
         );
     }
 }
+
+/// Issue 20 item 6, cells converting back and forth: a flat layer at rest whose surface lies on a
+/// node boundary (the interface row full, m = ρ, exactly at the filling threshold) with no
+/// conversion margin (κ = 0) fills and empties its surface nodes step after step; Körner et al.'s
+/// κ = 1e-3 converts none. A steep wave at low τ with κ = 0 fails at the Mach limit, and the
+/// failure names the flip-flopping surface too; a coarse dam break with the default κ is not
+/// named. Measured 2026-12-01 (64 × 32 nodes): flat, κ = 0: 0.21 flips per interface node and
+/// step over 1000 steps (limit 1e-2); κ = 1e-3: no conversion; steep wave κ = 0: 1.8e-2 over its
+/// run, failing at step 774; the dam break 4.3e-3.
+#[test]
+fn a_layer_flip_flopping_at_its_surface_is_named() {
+    use lbdem_lbm::free_surface::{FlipFlops, FreeSurfaceParams, flips::FLIP_LIMIT};
+    use lbdem_lbm::{LbmError, Limits, Settings};
+    let layer_with = |h: f64, amp: f64, g: f64, tau: f64, kappa: f64| {
+        let (s, _) = layer(64, 32, h, amp, g, Collision::Bgk { tau }).unwrap();
+        let settings = Settings {
+            collision: Collision::Bgk { tau },
+            force: [0.0, -g, 0.0],
+            limits: Limits::default(),
+        };
+        let params = FreeSurfaceParams {
+            kappa,
+            ..FreeSurfaceParams::default()
+        };
+        let st = FreeSurfaceStepper::new(&s, settings, params).unwrap();
+        (s, st)
+    };
+    // the flat layer at rest
+    let mut rates = Vec::new();
+    for kappa in [0.0, 1e-3] {
+        let (mut s, mut st) = layer_with(12.0, 0.0, 1e-4, 0.6, kappa);
+        for _ in 0..1000 {
+            st.step(&mut s).expect("a layer at rest is stable");
+        }
+        let f: &FlipFlops = st.flips();
+        eprintln!(
+            "flat layer, kappa {kappa}: {} conversions, {} flips, {:.3e} per interface node-step",
+            f.conversions,
+            f.flips,
+            f.rate()
+        );
+        rates.push((f.conversions, f.rate(), st.flip_warning()));
+    }
+    let (_, rate0, warn0) = &rates[0];
+    assert!(*rate0 > 10.0 * FLIP_LIMIT, "{rate0}");
+    let w = warn0.as_ref().expect("kappa = 0 named");
+    assert!(w.contains("back and forth") && w.contains("raise kappa"), "{w}");
+    assert_eq!(rates[1].0, 0, "kappa = 1e-3 converts nothing at rest");
+    assert!(rates[1].2.is_none());
+    // the steep wave with kappa = 0 fails, and the failure names the flip-flopping surface
+    let (mut s, mut st) = layer_with(12.0, 3.0, 2e-3, 0.505, 0.0);
+    let failure = (0..3000).find_map(|k| st.step(&mut s).err().map(|e| (k, e)));
+    let Some((k, LbmError::Unstable { cause, .. })) = failure else {
+        panic!("expected the steep wave with kappa = 0 to fail within 3000 steps");
+    };
+    eprintln!(
+        "steep wave, kappa 0: failed at step {k} ({:.3e} over the run, {:.3e} in the last window): {cause}",
+        st.flips().rate(),
+        st.flips().recent_rate()
+    );
+    assert!(cause.contains("back and forth"), "{cause}");
+    // the coarse dam break of `dam_break_front_matches_martin_moyce_coarse` (to T = 3.4), default
+    // kappa: not named
+    let (mut s, mut st) = dam_break(
+        16,
+        96,
+        36,
+        2e-4,
+        Collision::Trt {
+            tau: 0.51,
+            magic: 0.25,
+        },
+    )
+    .unwrap();
+    for _ in 0..680 {
+        st.step(&mut s).expect("the coarse dam break runs");
+    }
+    eprintln!(
+        "dam break: {:.3e} flips per interface node-step",
+        st.flips().rate()
+    );
+    assert!(st.flip_warning().is_none(), "{:?}", st.flip_warning());
+}

@@ -145,7 +145,7 @@ impl Model for InclineModel {
         ))
     }
     fn warnings(&self) -> Vec<String> {
-        self.run.creep().1.into_iter().collect()
+        self.run.warnings()
     }
     fn describe(&self) -> serde_json::Value {
         serde_json::json!({

@@ -30,7 +30,7 @@ use lbdem_dem::spheres::{
 };
 use lbdem_dem::vector::{Vec3, Vector};
 use lbdem_lbm::free_surface::{
-    ClampCreep, Conversions, FreeSurface, FreeSurfaceParams, FreeSurfaceStepper, INTERFACE, LIQUID,
+    ClampCreep, Conversions, FlipFlops, FreeSurface, FreeSurfaceParams, FreeSurfaceStepper, INTERFACE, LIQUID,
 };
 use lbdem_lbm::{Bingham, Collision, D3Q19, Domain, Face, Limits, Settings};
 use nalgebra::UnitQuaternion;
@@ -113,6 +113,9 @@ pub struct InclineState {
     /// The creep monitor of the paste at τ_max (absent in checkpoints written before it).
     #[serde(default)]
     pub creep: Option<ClampCreep>,
+    /// The flip counter of the surface (absent in checkpoints written before it).
+    #[serde(default)]
+    pub flips: Option<FlipFlops>,
 }
 
 /// LBM steps per window of the creep monitor (`lbdem_lbm::free_surface::ClampCreep`): 3 ms at the
@@ -419,6 +422,7 @@ impl Incline {
             system: self.run.sys.clone(),
             lifted: self.lifted,
             creep: self.run.grains.stepper().creep().cloned(),
+            flips: Some(self.run.grains.stepper().flips().clone()),
         }
     }
 
@@ -434,6 +438,9 @@ impl Incline {
         self.run.grains.set_state(state.grains)?;
         if let Some(c) = state.creep {
             self.run.grains.stepper_mut().restore_creep(c);
+        }
+        if let Some(f) = state.flips {
+            self.run.grains.stepper_mut().restore_flips(f);
         }
         self.run.sys = state.system;
         self.run.dem = lbdem_dem::spheres::SphereStepper::new();
@@ -477,6 +484,13 @@ impl Incline {
     /// Physical time (s).
     pub fn time(&self) -> f64 {
         self.run.grains.liquid.step as f64 * self.spec.dt
+    }
+
+    /// The accuracy failures of the free surface measured so far, named with their fixes: the
+    /// creep at the Bingham clamp and cells converting back and forth.
+    pub fn warnings(&self) -> Vec<String> {
+        let st = self.run.grains.stepper();
+        st.creep_warning().into_iter().chain(st.flip_warning()).collect()
     }
 
     /// The share of the paste's volume that moved while at least 95 % of it sat at τ_max (the

@@ -44,6 +44,8 @@ pub struct Conversions {
     pub new_interface: usize,
     /// Excess mass put into the reservoir this step.
     pub to_reservoir: f64,
+    /// Interface nodes before the conversions.
+    pub interface: usize,
 }
 
 /// Scratch lists of the conversions (reused from step to step).
@@ -52,8 +54,22 @@ pub struct ConvertScratch {
     filled: Vec<usize>,
     emptied: Vec<usize>,
     new_interface: Vec<usize>,
+    /// Liquid nodes that became interface beside an emptied one.
+    demoted: Vec<usize>,
     /// Per node: 1 filled, 2 emptied, 4 new interface.
     flag: Vec<u8>,
+}
+
+impl ConvertScratch {
+    /// Every node the last [`convert`] changed, as (node, kind before, kind after).
+    pub fn changes(&self) -> impl Iterator<Item = (usize, u8, u8)> + '_ {
+        self.filled
+            .iter()
+            .map(|&x| (x, INTERFACE, LIQUID))
+            .chain(self.emptied.iter().map(|&x| (x, INTERFACE, GAS)))
+            .chain(self.new_interface.iter().map(|&x| (x, GAS, INTERFACE)))
+            .chain(self.demoted.iter().map(|&x| (x, LIQUID, INTERFACE)))
+    }
 }
 
 const FILL: u8 = 1;
@@ -82,12 +98,15 @@ pub fn convert<L: Lattice>(
     sc.filled.clear();
     sc.emptied.clear();
     sc.new_interface.clear();
+    sc.demoted.clear();
     sc.flag.clear();
     sc.flag.resize(n, 0);
+    let mut interface = 0;
     for x in 0..n {
         if s.cell[x] != INTERFACE {
             continue;
         }
+        interface += 1;
         let isolated = !nbrs::<L>(links, n, x).any(|j| matches!(s.cell[j], LIQUID | INTERFACE));
         let (mut fill_lonely, mut empty_lonely) = (false, false);
         if lonely > 0.0 {
@@ -103,7 +122,10 @@ pub fn convert<L: Lattice>(
             sc.flag[x] = EMPTY;
         }
     }
-    let mut out = Conversions::default();
+    let mut out = Conversions {
+        interface,
+        ..Conversions::default()
+    };
     if sc.filled.is_empty() && sc.emptied.is_empty() {
         spread_reservoir(s);
         return out;
@@ -150,6 +172,7 @@ pub fn convert<L: Lattice>(
         for j in nbrs::<L>(links, n, x) {
             if s.cell[j] == LIQUID {
                 s.cell[j] = INTERFACE;
+                sc.demoted.push(j);
             }
         }
         s.cell[x] = GAS;

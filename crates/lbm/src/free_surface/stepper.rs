@@ -12,6 +12,7 @@
 use super::cells::{FreeSurface, GAS, GRAIN, INTERFACE, LIQUID, WALL};
 use super::convert::{Conversions, ConvertScratch, convert};
 use super::creep::ClampCreep;
+use super::flips::FlipFlops;
 use super::mass::{link_exchange, link_weight};
 use super::reconstruct::{atmosphere, from_gas};
 use crate::LbmError;
@@ -72,6 +73,8 @@ pub struct FreeSurfaceStepper<L: Lattice> {
     tau: Option<Vec<f64>>,
     /// The creep of the paste at τ_max (`monitor_creep`).
     creep: Option<ClampCreep>,
+    /// Cells converting back and forth (always counted: the failure diagnosis reads it).
+    flips: FlipFlops,
     _l: PhantomData<L>,
 }
 
@@ -147,6 +150,7 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
             scratch: ConvertScratch::default(),
             tau: None,
             creep: None,
+            flips: FlipFlops::new(n),
             _l: PhantomData,
         })
     }
@@ -197,6 +201,22 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
         if self.creep.is_some() {
             self.creep = Some(state);
         }
+    }
+
+    /// The flip counter ([`FlipFlops`]: cells converting back and forth at the surface).
+    pub fn flips(&self) -> &FlipFlops {
+        &self.flips
+    }
+
+    /// Put back a flip counter from a checkpoint (one of the same box).
+    pub fn restore_flips(&mut self, state: FlipFlops) {
+        self.flips = state;
+    }
+
+    /// The surface named as flip-flopping, when its rate over the run passed
+    /// [`super::flips::FLIP_LIMIT`].
+    pub fn flip_warning(&self) -> Option<String> {
+        FlipFlops::describe(self.flips.rate(), self.params.kappa, self.params.lonely)
     }
 
     /// The creep of the paste at τ_max named, when it passed [`super::creep::CREEP_LIMIT`].
@@ -258,6 +278,10 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
             self.params.lonely,
             &mut self.scratch,
         );
+        for (x, from, to) in self.scratch.changes() {
+            self.flips.record(s.step, x, from, to);
+        }
+        self.flips.end_step(s.step, conversions.interface);
         if let (Some(c), Some(b), Some(t)) = (self.creep.as_mut(), &bingham, &self.tau)
             && s.step.is_multiple_of(c.every)
             && t.len() == s.nodes()
@@ -298,6 +322,11 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
                     "; at the free surface (an interface node or next to one: a falling or spreading \
                      front, where the liquid is fastest and thinnest)",
                 );
+            }
+            let flips = self.flips.rate().max(self.flips.recent_rate());
+            if let Some(w) = FlipFlops::describe(flips, self.params.kappa, self.params.lonely) {
+                cause.push_str("; ");
+                cause.push_str(&w);
             }
             if let (Some(b), Some(t)) = (&self.bingham, local) {
                 let (lo, hi) = (1.0 / b.omega_hi, 1.0 / b.omega_lo);
