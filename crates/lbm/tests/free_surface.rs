@@ -324,6 +324,36 @@ fn the_sweep_gives_the_same_bits_on_any_thread_count() {
     assert_eq!(a.cell, b.cell);
 }
 
+/// A dam-break column a wide and 2a high (box 160 × (2a + 4), g 1e-4, TRT τ 0.515) of Bingham
+/// paste μ_pl 0.005 with yield stress `yield_stress`, τ clamped to [0.501, `tau_max`].
+fn bingham_column(
+    a: usize,
+    yield_stress: f64,
+    tau_max: f64,
+) -> (FreeSurface<D2Q9>, FreeSurfaceStepper<D2Q9>) {
+    let (s, mut st) = dam_break(
+        a,
+        160,
+        2 * a + 4,
+        1e-4,
+        Collision::Trt {
+            tau: 0.515,
+            magic: 0.25,
+        },
+    )
+    .unwrap();
+    st.set_bingham(Some(lbdem_lbm::Bingham {
+        mu_pl: 0.005,
+        yield_stress,
+        rho: 1.0,
+        tau_min: 0.501,
+        tau_max,
+        smagorinsky: 0.0,
+    }))
+    .unwrap();
+    (s, st)
+}
+
 /// The Bingham collider under a free surface (Leonardi et al. 2014 Sects. 5.2-5.3 together): a
 /// dam-break column of height H = 2a that a Bingham paste of yield stress σ_y can hold. A
 /// vertical cut of a Tresca material stands below about H_c = 3.83 σ_y/(ρg) (the limit-analysis
@@ -335,29 +365,9 @@ fn the_sweep_gives_the_same_bits_on_any_thread_count() {
 /// slumps part way. All keep the mass to round-off and a closed interface.
 #[test]
 fn a_bingham_column_with_enough_yield_stress_stands() {
-    use lbdem_lbm::Bingham;
     let a = 16;
     let run = |yield_stress: f64| {
-        let (mut s, mut st) = dam_break(
-            a,
-            160,
-            2 * a + 4,
-            1e-4,
-            Collision::Trt {
-                tau: 0.515,
-                magic: 0.25,
-            },
-        )
-        .unwrap();
-        st.set_bingham(Some(Bingham {
-            mu_pl: 0.005,
-            yield_stress,
-            rho: 1.0,
-            tau_min: 0.501,
-            tau_max: 3.5,
-            smagorinsky: 0.0,
-        }))
-        .unwrap();
+        let (mut s, mut st) = bingham_column(a, yield_stress, 3.5);
         let (drift, _) = run_closed(&mut s, &mut st, 3000);
         (front_position(&s) - a as f64, drift)
     };
@@ -495,29 +505,9 @@ fn a_thin_sheet_in_the_gas_is_emptied_by_the_lonely_rule_keeping_the_mass() {
 /// measures falls with the ceiling.
 #[test]
 fn a_column_creeping_at_the_bingham_ceiling_is_named() {
-    use lbdem_lbm::Bingham;
     let a = 16;
     let run = |tau_max: f64| {
-        let (mut s, mut st) = dam_break(
-            a,
-            160,
-            2 * a + 4,
-            1e-4,
-            Collision::Trt {
-                tau: 0.515,
-                magic: 0.25,
-            },
-        )
-        .unwrap();
-        st.set_bingham(Some(Bingham {
-            mu_pl: 0.005,
-            yield_stress: 2e-3,
-            rho: 1.0,
-            tau_min: 0.501,
-            tau_max,
-            smagorinsky: 0.0,
-        }))
-        .unwrap();
+        let (mut s, mut st) = bingham_column(a, 2e-3, tau_max);
         st.monitor_creep(Some(100), s.nodes());
         let (drift, _) = run_closed(&mut s, &mut st, 3000);
         assert!(drift < 1e-14, "mass drift {drift:e}");
