@@ -508,7 +508,7 @@ fn a_column_creeping_at_the_bingham_ceiling_is_named() {
     let a = 16;
     let run = |tau_max: f64| {
         let (mut s, mut st) = bingham_column(a, 2e-3, tau_max);
-        st.monitor_creep(Some(100), s.nodes());
+        st.monitor_creep(Some(100));
         let (drift, _) = run_closed(&mut s, &mut st, 3000);
         assert!(drift < 1e-14, "mass drift {drift:e}");
         let c = st.creep().expect("monitor on");

@@ -96,7 +96,7 @@ impl Model for InclineModel {
             self.run.rigid_share(),
             (mass - self.mass0) / self.mass0,
             self.run.max_pebble_speed(),
-            self.run.creep().0,
+            self.run.creep(),
         ]
     }
     fn probe(&self, q: Probe) -> Option<f64> {

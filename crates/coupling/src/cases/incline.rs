@@ -321,7 +321,7 @@ impl Incline {
         )?;
         stepper.set_bingham(Some(bingham))?;
         stepper.record_tau(true, liquid.nodes());
-        stepper.monitor_creep(Some(CREEP_WINDOW), liquid.nodes());
+        stepper.monitor_creep(Some(CREEP_WINDOW));
         let scale = SurfaceScale {
             dx,
             dt,
@@ -494,11 +494,9 @@ impl Incline {
     }
 
     /// The share of the paste's volume that moved while at least 95 % of it sat at τ_max (the
-    /// creep at the Bingham clamp, `ClampCreep::moved`), and the failure named when above its
-    /// limit.
-    pub fn creep(&self) -> (f64, Option<String>) {
-        let st = self.run.grains.stepper();
-        (st.creep().map_or(0.0, |c| c.moved), st.creep_warning())
+    /// creep at the Bingham clamp, `ClampCreep::moved`; [`Self::warnings`] names it).
+    pub fn creep(&self) -> f64 {
+        self.run.grains.stepper().creep().map_or(0.0, |c| c.moved)
     }
 
     /// Share of the paste's nodes (liquid and interface) whose relaxation time is at τ_max: the

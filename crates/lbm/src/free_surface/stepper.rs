@@ -184,10 +184,10 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
     /// Measure the creep of the paste held at τ_max every `every` steps of a Bingham run
     /// ([`ClampCreep`]: the Bingham clamp at low shear rate, an accuracy failure no blow-up
     /// shows); `None` stops it. Starts τ recording (the monitor reads it).
-    pub fn monitor_creep(&mut self, every: Option<u64>, nodes: usize) {
+    pub fn monitor_creep(&mut self, every: Option<u64>) {
         self.creep = every.map(ClampCreep::new);
         if every.is_some() && self.tau.is_none() {
-            self.tau = Some(vec![f64::NAN; nodes]);
+            self.tau = Some(vec![f64::NAN; self.f_new.len() / L::Q]);
         }
     }
 
