@@ -33,14 +33,16 @@ pub fn model(l: &Loaded, resume: bool) -> Result<Box<dyn Model>> {
     })
 }
 
-/// The run's length in steps: `[run] steps` or `time`, after the shear cell's settling if any.
+/// The run's length in steps: `[run] steps` or `time`, after the shear cell's settling if any
+/// (its longest, with `settle_until_rest`: a run let go earlier ends at its stop condition or
+/// runs on for the time its settling did not take).
 pub fn total_steps(s: &Scene, dt: f64) -> u64 {
     let run = match (s.run.steps, s.run.time) {
         (Some(n), _) => n,
         (None, Some(t)) => (t / dt).round().max(1.0) as u64,
         _ => 1,
     };
-    run + models::shear_cell::settle_steps(s, dt).unwrap_or(0)
+    run + models::shear_cell::settle_steps(s, dt).map_or(0, |(_, last)| last)
 }
 
 /// The DEM index of a wall given by index (a box counts as four) or by its `name`.

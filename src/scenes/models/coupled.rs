@@ -525,6 +525,11 @@ impl<T: Real> Model for CoupledModel<T> {
             .as_ref()
             .map(|c| c.note(&self.run.sys, self.steps_done()))
     }
+    fn warnings(&self) -> Vec<String> {
+        self.cell
+            .as_ref()
+            .map_or_else(Vec::new, |c| c.warnings(self.dt()))
+    }
     fn describe(&self) -> serde_json::Value {
         let tm = self.run.timing;
         let total = (tm.lbm + tm.dem + tm.coupling).as_secs_f64().max(1e-12);

@@ -200,6 +200,11 @@ impl Model for Dry {
     fn progress_note(&self) -> Option<String> {
         self.cell.as_ref().map(|c| c.note(&self.sys, self.sys.step))
     }
+    fn warnings(&self) -> Vec<String> {
+        self.cell
+            .as_ref()
+            .map_or_else(Vec::new, |c| c.warnings(self.params.dt))
+    }
     fn describe(&self) -> serde_json::Value {
         serde_json::json!({
             "bodies": self.sys.bodies.len(), "contact_law": law_name(&self.law),

@@ -18,7 +18,7 @@ use anyhow::{Result, bail};
 use lbdem_dem::polygon::{plate_region, sample_area};
 use lbdem_dem::{Stepper, System, Vec2, Vector, WallMotion};
 
-pub const COLUMNS: [&str; 8] = [
+pub const COLUMNS: [&str; 9] = [
     "settling",
     "plate_displacement",
     "plate_displacement_d",
@@ -27,6 +27,7 @@ pub const COLUMNS: [&str; 8] = [
     "eps_vol_dem",
     "mean_stress",
     "inertial_number",
+    "fastest_grain",
 ];
 
 /// The push-plate cell of a scene with `[shear_cell]`.
@@ -223,6 +224,7 @@ impl ShearCell {
             (a / a0).ln(),
             p,
             self.inertial_number(p, Self::density(sys)),
+            sys.bodies.max_speed(),
         ]
     }
 }
@@ -238,12 +240,24 @@ pub struct Tracked {
     hold: Option<Hold>,
 }
 
-/// The plate held still until the model's step `until`, then moving at `velocity`. Whether the
-/// run is settling follows from the step count, so a checkpoint needs nothing more.
+/// The plate held still for at least `until` steps of the model and at most `last`, then
+/// moving at `velocity`. Without `rest_speed` the two are the same step, and whether the run
+/// is settling follows from the step count; with it, the step the plate was let go (and the
+/// fastest grain's speed then) is part of the checkpoint ([`Origin::released`]).
 #[derive(Clone, Copy, Debug)]
 struct Hold {
     until: u64,
+    last: u64,
+    rest_speed: Option<f64>,
     velocity: Vec2,
+    released: Option<Release>,
+}
+
+/// When the plate was let go: the model's step and the fastest grain's speed (m/s) then.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Release {
+    pub step: u64,
+    pub fastest_grain: f64,
 }
 
 /// The part of [`Tracked`] a checkpoint keeps.
@@ -251,21 +265,36 @@ struct Hold {
 pub struct Origin {
     pub start: Vec2,
     pub a0: f64,
+    /// None in checkpoints written before `settle_until_rest` (their hold has a fixed length).
+    #[serde(default)]
+    pub released: Option<Release>,
 }
 
 impl Tracked {
     /// The scene's cell as the system stands now (None without `[shear_cell]`); with `settle`,
-    /// the plate is held for that long in steps of `dt` (s, the model's step).
+    /// the plate is held for that long in steps of `dt` (s, the model's step), and with
+    /// `settle_until_rest` on until the grains are at rest.
     pub fn start(s: &Scene, sys: &mut System, dt: f64) -> Result<Option<Self>> {
         let Some(cell) = ShearCell::new(s, sys)? else {
             return Ok(None);
         };
-        let hold = settle_steps(s, dt).map(|until| {
+        let hold = settle_steps(s, dt).map(|(until, last)| {
             // Held by its velocity alone: its motion still says which side is behind it.
             let w = &mut sys.walls[cell.plate];
             let velocity = w.vel;
             w.vel = Vec2::ZERO;
-            Hold { until, velocity }
+            let rest_speed = s
+                .shear_cell
+                .as_ref()
+                .and_then(|sc| sc.settle_until_rest)
+                .map(|r| r.speed);
+            Hold {
+                until,
+                last,
+                rest_speed,
+                velocity,
+                released: None,
+            }
         });
         let a0 = cell.area(sys);
         Ok(Some(Self {
@@ -278,31 +307,75 @@ impl Tracked {
 
     /// Whether the plate is still held after `steps` steps of the model.
     pub fn settling(&self, steps: u64) -> bool {
-        self.hold.is_some_and(|h| steps < h.until)
+        self.hold.is_some_and(|h| match h.released {
+            Some(r) => steps < r.step,
+            None => steps < h.last,
+        })
     }
 
-    /// After each step of the model: at the end of the settling, set the plate moving and take
-    /// A_0 and the plate's origin from the settled sample. True at that step.
+    /// After each step of the model: at the end of the settling (the step `settle` names, or
+    /// with `settle_until_rest` the first step after it with every grain slower than its
+    /// speed, or its `max_time`), set the plate moving and take A_0 and the plate's origin from
+    /// the settled sample. True at that step.
     pub fn after_step(&mut self, sys: &mut System, steps: u64) -> bool {
-        if let Some(h) = self.hold
-            && steps == h.until
-        {
-            sys.walls[self.cell.plate].vel = h.velocity;
-            self.start = self.cell.plate_anchor(sys);
-            self.a0 = self.cell.area(sys);
-            return true;
+        let Some(h) = &mut self.hold else {
+            return false;
+        };
+        if h.released.is_some() {
+            return false;
         }
-        false
+        let fastest = sys.bodies.max_speed();
+        // `==` at the last step: a checkpoint of a fixed hold written before `released` was
+        // kept restores with none, and must not be let go a second time.
+        let go = steps == h.last || (steps >= h.until && h.rest_speed.is_some_and(|v| fastest < v));
+        if !go {
+            return false;
+        }
+        h.released = Some(Release {
+            step: steps,
+            fastest_grain: fastest,
+        });
+        sys.walls[self.cell.plate].vel = h.velocity;
+        self.start = self.cell.plate_anchor(sys);
+        self.a0 = self.cell.area(sys);
+        true
     }
     pub fn origin(&self) -> Origin {
         Origin {
             start: self.start,
             a0: self.a0,
+            released: self.hold.and_then(|h| h.released),
         }
     }
     pub fn set_origin(&mut self, o: Origin) {
         self.start = o.start;
         self.a0 = o.a0;
+        if let Some(h) = &mut self.hold {
+            h.released = o.released;
+        }
+    }
+
+    /// When the plate was let go (None while held, or without a settling).
+    pub fn released(&self) -> Option<Release> {
+        self.hold.and_then(|h| h.released)
+    }
+
+    /// A settling to rest that ran out of time: the plate was let go with grains still moving
+    /// faster than the criterion, so what is sheared is a sample still relaxing.
+    pub fn warnings(&self, dt: f64) -> Vec<String> {
+        let Some(h) = self.hold else {
+            return Vec::new();
+        };
+        match (h.rest_speed, h.released) {
+            (Some(v), Some(r)) if r.fastest_grain >= v => vec![format!(
+                "[shear_cell] settle_until_rest: the plate was let go at max_time = {:.3} s with the fastest grain \
+                 at {:.2e} m/s, above speed = {v:e} m/s: the sample was still relaxing when the shear began; \
+                 raise max_time",
+                h.last as f64 * dt,
+                r.fastest_grain
+            )],
+            _ => Vec::new(),
+        }
     }
     pub fn sample(&self, sys: &System, st: &Stepper, steps: u64) -> Vec<f64> {
         self.cell
@@ -318,17 +391,31 @@ impl Tracked {
     /// "u_y = 2.41 d̄" for the progress bar ("settling" while the plate is held).
     pub fn note(&self, sys: &System, steps: u64) -> String {
         if self.settling(steps) {
-            return "settling, plate held".into();
+            return match self.hold.and_then(|h| h.rest_speed) {
+                Some(_) => format!(
+                    "settling, plate held, fastest grain {:.1e} m/s",
+                    sys.bodies.max_speed()
+                ),
+                None => "settling, plate held".into(),
+            };
         }
         let u = self.cell.displacement(sys, self.start);
         format!("u_y = {:.2} d̄", u / self.cell.d_mean)
     }
 }
 
-/// `[shear_cell] settle` in steps of `dt` (None when 0 or without `[shear_cell]`).
-pub fn settle_steps(s: &Scene, dt: f64) -> Option<u64> {
-    let t = s.shear_cell.as_ref()?.settle;
-    (t > 0.0).then(|| (t / dt).round().max(1.0) as u64)
+/// `[shear_cell] settle` in steps of `dt`, and the longest hold (`settle_until_rest.max_time`,
+/// else the same); None without a settling or without `[shear_cell]`.
+pub fn settle_steps(s: &Scene, dt: f64) -> Option<(u64, u64)> {
+    let sc = s.shear_cell.as_ref()?;
+    let steps = |t: f64| (t / dt).round().max(1.0) as u64;
+    match sc.settle_until_rest {
+        Some(r) => Some((
+            if sc.settle > 0.0 { steps(sc.settle) } else { 0 },
+            steps(r.max_time),
+        )),
+        None => (sc.settle > 0.0).then(|| (steps(sc.settle), steps(sc.settle))),
+    }
 }
 
 /// How far wall `k` moved from `start` (its anchor at the start of the run), for the stop and

@@ -294,6 +294,16 @@ const RULES: &[Rule] = &[
         Need::NonNegative,
         "time with the plate held before it moves (s; 0 = none)",
     ),
+    Rule(
+        "shear_cell.settle_until_rest.speed",
+        Need::Positive,
+        "speed every grain must be below before the plate moves (m/s; Su: 1e-7)",
+    ),
+    Rule(
+        "shear_cell.settle_until_rest.max_time",
+        Need::Positive,
+        "longest hold of the plate (s)",
+    ),
     Rule("packed_zone.band", Need::Positive, "band thickness (m)"),
     Rule("packed_zone.slower_than", Need::Positive, "speed threshold (m/s)"),
     Rule("fluid.density", Need::Positive, "liquid density (kg/m³)"),

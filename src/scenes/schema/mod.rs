@@ -393,6 +393,16 @@ impl Scene {
                     sc.shear_length
                 );
             }
+            if let Some(r) = &sc.settle_until_rest
+                && r.max_time < sc.settle
+            {
+                bail!(
+                    "[shear_cell] settle_until_rest.max_time = {} s is shorter than settle = {} s, the shortest \
+                     hold; make max_time at least settle",
+                    r.max_time,
+                    sc.settle
+                );
+            }
         }
         let grain_only: [(&str, bool); 9] = [
             ("[packed_zone]", self.packed_zone.is_some()),

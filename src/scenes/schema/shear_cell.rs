@@ -36,6 +36,22 @@ pub struct ShearCellSection {
     /// plate's displacement are measured from the end of it; `[run] time` counts after it.
     #[serde(default)]
     pub settle: f64,
+    /// With `settle`: hold the plate on after it until every grain is slower than `speed`
+    /// (m/s; Su Sect. 2.4: 1e-7), for at most `max_time` seconds in all; a run released at
+    /// `max_time` with grains still moving says so after it ends. `settle` is then the
+    /// shortest hold (the grains start at rest, so the criterion holds at the first step).
+    #[serde(default)]
+    pub settle_until_rest: Option<UntilRest>,
+}
+
+/// `[shear_cell] settle_until_rest`.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct UntilRest {
+    /// Speed every grain must be below (m/s).
+    pub speed: f64,
+    /// Longest hold (s), `settle` included.
+    pub max_time: f64,
 }
 
 fn half() -> f64 {

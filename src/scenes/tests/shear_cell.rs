@@ -351,13 +351,22 @@ fn resumes_to_the_same_bits(edit: impl Fn(String) -> String) {
     let cut = t.path().join("cut");
     cell(&cut, |s| s);
     let limited = text.replace("[run]\n", "[run]\nwall_clock = 0.05\n");
-    let interruptions = resume_until_done(&limited, &cut, 200);
+    let interruptions = resume_until_done(&limited, &cut, 400);
     let a = std::fs::read(whole.join("out/series.csv")).unwrap();
     let b = std::fs::read(cut.join("out/series.csv")).unwrap();
     assert!(a == b, "series.csv differs after {interruptions} interruptions");
     let a = std::fs::read(last_snapshot(&whole.join("out"), "fluid")).unwrap();
     let b = std::fs::read(last_snapshot(&cut.join("out"), "fluid")).unwrap();
     assert!(a == b, "the last fluid snapshot differs");
+}
+
+/// The same with a settling to rest (`[shear_cell] settle_until_rest`): the step the plate was
+/// let go is in the checkpoint, not in the scene. Grains kicked towards the plate at 2 mm/s come
+/// below 5e-4 m/s at LBM step 49 (measured; the next test), after the 12 steps of `settle` and
+/// before the 80 of `max_time`, so checkpoints (every 5 steps) fall before and after the release.
+#[test]
+fn an_interrupted_run_settling_to_rest_resumes_to_the_same_bits() {
+    resumes_to_the_same_bits(|s| kicked(until_rest("5.0e-4", "0.04")(s)));
 }
 
 /// The same with the mass scale following the inertial number (`[dem.mass_scale_control]`):
@@ -409,6 +418,85 @@ fn settled(time: &str) -> impl Fn(String) -> String {
             "snapshots = { when = { quantity = \"wall_displacement\", wall = \"plate\", crosses = [0.0, 1.0e-5] } }",
         )
     }
+}
+
+/// The plate held after `settle` until every grain is slower than `speed` (m/s), for at most
+/// `max_time` seconds (`[shear_cell] settle_until_rest`); needs [`settled`] first.
+fn until_rest(speed: &'static str, max_time: &'static str) -> impl Fn(String) -> String {
+    move |t: String| {
+        let at = t.find("\nsettle = ").expect("settled() first") + 1;
+        let end = at + t[at..].find('\n').unwrap() + 1;
+        format!(
+            "{}settle_until_rest = {{ speed = {speed}, max_time = {max_time} }}\n{}",
+            &t[..end],
+            &t[end..]
+        )
+    }
+}
+
+/// The grains start towards the plate at 2 mm/s (the committed assembly is at rest, 1e-17 m/s),
+/// so that there is something to settle.
+fn kicked(t: String) -> String {
+    t.replace("[particles]\n", "[particles]\nvelocity = [0.0, -2.0e-3]\n")
+}
+
+/// `[shear_cell] settle_until_rest` (Su Sect. 2.4: relaxed until every grain is slower than
+/// 1e-7 m/s): the plate is let go at the first LBM step after `settle` with every grain slower
+/// than the criterion, the shear is measured from there, and a run whose grains never get there
+/// is let go at `max_time` and says so.
+#[test]
+fn a_settling_to_rest_lets_the_plate_go_when_every_grain_is_slower_than_the_criterion() {
+    let t = tempfile::tempdir().unwrap();
+    // Held at least 0.005 s (10 LBM steps), at most 0.1 s (200); then 0.01 s moving.
+    let run = |dir: &Path, speed: &'static str| {
+        let text = cell(dir, |s| {
+            kicked(until_rest(speed, "0.1")(settled("0.005")(shorter("0.01")(s))))
+                .replace("series = { every = 5 }", "series = { every = 1 }")
+        });
+        assert!(text.contains("settle_until_rest = { speed = ") && text.contains("every = 1 }"));
+        let rec = simulate(&text, dir, false).unwrap();
+        (rec, dir.join("out"))
+    };
+    // Measured: the fastest grain falls from 1.1e-3 m/s at step 5 to 5.1e-4 at step 48 and 4.5e-4
+    // at step 49, where the plate is let go (with 1e-9 it goes on ringing between 2e-4 and 9e-4).
+    let (rec, out) = run(&t.path().join("rest"), "5.0e-4");
+    let (step, settling) = (column(&out, "step"), column(&out, "settling"));
+    let (fastest, u) = (column(&out, "fastest_grain"), column(&out, "plate_displacement"));
+    let eps = column(&out, "eps_vol_dem");
+    let k = settling
+        .iter()
+        .position(|&x| x == 0.0)
+        .expect("the plate was let go");
+    let released = step[k];
+    assert!(
+        (11.0..200.0).contains(&released),
+        "let go at step {released}: not the shortest hold nor the longest"
+    );
+    assert!(fastest[k] < 5.0e-4, "let go with a grain at {:e} m/s", fastest[k]);
+    for j in 0..k {
+        assert_eq!(u[j], 0.0, "the plate moved at step {}", step[j]);
+        if step[j] >= 10.0 {
+            assert!(fastest[j] >= 5.0e-4, "at rest at step {} already", step[j]);
+        }
+    }
+    assert!(settling[k..].iter().all(|&x| x == 0.0));
+    assert_eq!(eps[k], 0.0, "A_0 is the sample's area when the plate is let go");
+    assert!(u.last().unwrap() > &0.0);
+    // [run] time counts after the longest hold: let go early, the run goes on to its end.
+    assert_eq!(rec.output.summary["steps"], 220, "{}", rec.output.summary);
+    assert_eq!(rec.output.summary["warnings"], serde_json::json!([]));
+
+    // Never at rest: let go at max_time, and said so.
+    let (rec, out) = run(&t.path().join("never"), "1.0e-9");
+    let settling = column(&out, "settling");
+    let step = column(&out, "step");
+    let k = settling.iter().position(|&x| x == 0.0).unwrap();
+    assert_eq!(step[k], 200.0, "let go at max_time");
+    let w = rec.output.summary["warnings"].to_string();
+    assert!(
+        w.contains("settle_until_rest") && w.contains("raise max_time"),
+        "{w}"
+    );
 }
 
 /// `[shear_cell] settle`: the plate stays still while the grains settle against the membrane,
@@ -517,7 +605,7 @@ fn the_same_cell_without_liquid_records_the_same_measures() {
 #[test]
 fn shear_cell_set_ups_that_cannot_work_are_refused_before_anything_runs() {
     let t = tempfile::tempdir().unwrap();
-    let cases: [(&dyn Fn(String) -> String, &str); 6] = [
+    let cases: [(&dyn Fn(String) -> String, &str); 7] = [
         (
             // critical step about 1.5e-5 s (lightest grain 2.4e-7 kg, k_n 1000 N/m); the grain
             // springs allow up to 2 sqrt(m/(6k + 2k)) = 1.09e-5 s, a clump resting on a wall
@@ -555,6 +643,10 @@ fn shear_cell_set_ups_that_cannot_work_are_refused_before_anything_runs() {
         (
             &|s: String| s.replace("lambda = 0.5 }", "lambda = 0.5, damping = 1.0 }"),
             "[bonds] params.damping = 1",
+        ),
+        (
+            &|s: String| until_rest("1.0e-7", "0.01")(settled("0.02")(s)),
+            "settle_until_rest.max_time = 0.01 s is shorter than settle = 0.02 s",
         ),
     ];
     for (k, (edit, msg)) in cases.iter().enumerate() {
