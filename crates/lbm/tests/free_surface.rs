@@ -509,6 +509,12 @@ fn a_column_creeping_at_the_bingham_ceiling_is_named() {
     let run = |tau_max: f64| {
         let (mut s, mut st) = bingham_column(a, 2e-3, tau_max);
         st.monitor_creep(Some(100));
+        // The monitor keeps the τ field it reads: turning the recording off leaves it on.
+        st.record_tau(false, s.nodes());
+        assert!(
+            st.tau().is_some(),
+            "record_tau(false) stopped the creep monitor's field"
+        );
         let (drift, _) = run_closed(&mut s, &mut st, 3000);
         assert!(drift < 1e-14, "mass drift {drift:e}");
         let c = st.creep().expect("monitor on");

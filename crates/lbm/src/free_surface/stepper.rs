@@ -176,9 +176,10 @@ impl<L: Lattice> FreeSurfaceStepper<L> {
     /// Record the local relaxation time of every liquid and interface node at each step of a
     /// Bingham run ([`Self::tau`]; Leonardi et al. 2014 Fig. 8 plots the viscosity it gives and
     /// stops the incline when 95 % of the liquid is at τ_max). On from `set_bingham` (the
-    /// failure diagnosis reads it); `false` stops it.
+    /// failure diagnosis reads it); `false` stops it, unless the creep monitor reads it
+    /// ([`Self::monitor_creep`]), which keeps it on until the monitor is stopped.
     pub fn record_tau(&mut self, on: bool, nodes: usize) {
-        self.tau = on.then(|| vec![f64::NAN; nodes]);
+        self.tau = (on || self.creep.is_some()).then(|| vec![f64::NAN; nodes]);
     }
 
     /// Measure the creep of the paste held at τ_max every `every` steps of a Bingham run
