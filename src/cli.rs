@@ -29,6 +29,16 @@ pub fn command() -> Command {
                         .long("force")
                         .action(ArgAction::SetTrue)
                         .help("Rerun every stage even when its inputs and parameters are unchanged"),
+                )
+                .arg(
+                    Arg::new("lanes")
+                        .long("lanes")
+                        .value_parser(clap::value_parser!(u64).range(1..=256))
+                        .default_value("1")
+                        .help(
+                            "Stages side by side, each once the stages it reads have finished, in a pool \
+                             of its share of the cores (e.g. 2 on 2 cores for one-thread simulations)",
+                        ),
                 ),
         )
         .subcommand(sweep_command())
@@ -188,7 +198,8 @@ pub fn main() -> Result<()> {
     match m.subcommand() {
         Some(("run", a)) => {
             let path = a.get_one::<PathBuf>("pipeline").context("PIPELINE is required")?;
-            pipeline::run_file(path, a.get_flag("force"))
+            let lanes = a.get_one::<u64>("lanes").copied().unwrap_or(1) as usize;
+            pipeline::run_file(path, a.get_flag("force"), lanes)
         }
         Some(("sweep", a)) => {
             let file = a

@@ -81,6 +81,7 @@ pub struct Interrupted {
 }
 
 /// What a stage gets besides its parameters.
+#[derive(Clone)]
 pub struct StageContext {
     /// Where the stage writes (the runner's working directory). Exists when `run` is called.
     pub out_dir: PathBuf,
@@ -112,6 +113,12 @@ impl StageContext {
             key: String::new(),
             progress: MultiProgress::new(),
         }
+    }
+
+    /// Draw this stage's progress bars in `progress`, beside those of stages running alongside
+    /// it (`lbdem run --lanes`), instead of in a display of its own.
+    pub fn share_progress(&mut self, progress: &MultiProgress) {
+        self.progress = progress.clone();
     }
 
     /// The same context writing somewhere else (the runner's working directory).

@@ -5,6 +5,7 @@
 
 mod cache;
 mod key_parts;
+pub mod lanes;
 pub mod provenance;
 pub mod schema;
 
@@ -241,10 +242,19 @@ pub fn run_alone(kind: &StageKind, inv: Invocation) -> Result<()> {
 /// Every stage's parameters are parsed before anything runs or is written, so a typo in the
 /// last stage fails at once instead of after the long ones. A resumable stage whose earlier
 /// run was interrupted with the same parameters and inputs continues from its checkpoint.
-pub fn run_file(path: &Path, force: bool) -> Result<()> {
+pub fn run_file(path: &Path, force: bool, lanes: usize) -> Result<()> {
     let pipeline = schema::Pipeline::load(path)?;
     let out = pipeline.out_dir();
-    run_pipeline(&pipeline, path, &out, RunOpts { force, quiet: false })?;
+    run_pipeline(
+        &pipeline,
+        path,
+        &out,
+        RunOpts {
+            force,
+            quiet: false,
+            lanes,
+        },
+    )?;
     Ok(())
 }
 
@@ -256,6 +266,9 @@ pub struct RunOpts {
     /// Print nothing per stage (a sweep runs many pipelines side by side under one progress
     /// display).
     pub quiet: bool,
+    /// Stages side by side (0 and 1: one after another): a stage starts once the stages it
+    /// reads have finished ([`lanes::dependencies`]), in a pool of its share of the cores.
+    pub lanes: usize,
 }
 
 /// Run `pipeline` into `out`, its provenance naming `file` (the pipeline file, or the sweep
@@ -304,42 +317,34 @@ fn run_planned(
     opts: RunOpts,
 ) -> Result<Vec<StageRecord>> {
     let out = out.to_path_buf();
-    let mut prov = provenance::start(file, pipeline)?;
+    let prov = std::sync::Mutex::new(provenance::start(file, pipeline)?);
     let t_all = Instant::now();
     let say = |m: String| {
         if !opts.quiet {
             eprintln!("{m}");
         }
     };
-    let mut records = Vec::new();
-    for (mut ctx, prepared, spec) in planned {
-        // Prepared again now that the earlier stages have run: a stage that reads what an
-        // earlier one wrote (a snapshot directory) lists those files among its inputs only now,
-        // and its key must hold them the first time as on every rerun.
-        drop(prepared);
-        let prepared = registry::find(&spec.kind)?.prepare(spec.params.clone(), &ctx)?;
-        let record = match (opts.force, cache::reusable(&prepared, &ctx)?) {
-            (false, Some(mut old)) => {
-                say(format!(
-                    "{:>12}  unchanged, skipped (ran in {:.2} s before)",
-                    ctx.name, old.wall_s
-                ));
-                old.cached = true;
-                old
-            }
-            _ => {
-                ctx.resume = prepared.resumable && cache::resumable(&prepared, &ctx)?;
-                let how = if ctx.resume { "resuming" } else { "running" };
-                say(format!("{:>12}  {how} ({})", ctx.name, prepared.kind));
-                let r = execute(prepared, &ctx)?;
-                say(format!("{:>12}  done in {:.2} s", ctx.name, r.wall_s));
-                r
-            }
-        };
-        prov.add(&record, &ctx.out_dir);
-        prov.write(&out)?;
-        records.push(record);
-    }
+    // The plans were only the check that every stage's parameters parse: each is prepared
+    // again as it starts.
+    let (ctxs, specs): (Vec<StageContext>, Vec<&schema::StageSpec>) =
+        planned.into_iter().map(|(ctx, _, spec)| (ctx, spec)).unzip();
+    let done = |ctx: &StageContext, record: &StageRecord| -> Result<()> {
+        let mut p = prov.lock().unwrap_or_else(|e| e.into_inner());
+        p.add(record, &ctx.out_dir);
+        p.write(&out)
+    };
+    let records = if opts.lanes > 1 && specs.len() > 1 {
+        side_by_side(&ctxs, &specs, opts, &say, &done)?
+    } else {
+        let mut records = Vec::new();
+        for (ctx, spec) in ctxs.into_iter().zip(specs) {
+            let record = run_stage(ctx.clone(), spec, opts, &say)?;
+            done(&ctx, &record)?;
+            records.push(record);
+        }
+        records
+    };
+    let mut prov = prov.into_inner().unwrap_or_else(|e| e.into_inner());
     prov.total_wall_s = t_all.elapsed().as_secs_f64();
     prov.write(&out)?;
     say(format!(
@@ -349,6 +354,122 @@ fn run_planned(
         out.display()
     ));
     Ok(records)
+}
+
+/// One stage of a pipeline whose earlier stages it reads have run: reused when its key is
+/// unchanged, continued from an interrupted run's checkpoint, or run.
+fn run_stage(
+    mut ctx: StageContext,
+    spec: &schema::StageSpec,
+    opts: RunOpts,
+    say: &(dyn Fn(String) + Sync),
+) -> Result<StageRecord> {
+    // Prepared now that the earlier stages have run: a stage that reads what an earlier one
+    // wrote (a snapshot directory) lists those files among its inputs only now, and its key
+    // must hold them the first time as on every rerun.
+    let prepared = registry::find(&spec.kind)?.prepare(spec.params.clone(), &ctx)?;
+    Ok(match (opts.force, cache::reusable(&prepared, &ctx)?) {
+        (false, Some(mut old)) => {
+            say(format!(
+                "{:>12}  unchanged, skipped (ran in {:.2} s before)",
+                ctx.name, old.wall_s
+            ));
+            old.cached = true;
+            old
+        }
+        _ => {
+            ctx.resume = prepared.resumable && cache::resumable(&prepared, &ctx)?;
+            let how = if ctx.resume { "resuming" } else { "running" };
+            say(format!("{:>12}  {how} ({})", ctx.name, prepared.kind));
+            let r = execute(prepared, &ctx)?;
+            say(format!("{:>12}  done in {:.2} s", ctx.name, r.wall_s));
+            r
+        }
+    })
+}
+
+/// [`run_stage`] for every stage, `opts.lanes` at a time, each once the stages it reads
+/// ([`lanes::dependencies`]) have finished; the first ready stage in file order takes a free
+/// lane. After a failure no stage starts; those running finish, and the first error is returned.
+fn side_by_side(
+    ctxs: &[StageContext],
+    specs: &[&schema::StageSpec],
+    opts: RunOpts,
+    say: &(dyn Fn(String) + Sync),
+    done: &(dyn Fn(&StageContext, &StageRecord) -> Result<()> + Sync),
+) -> Result<Vec<StageRecord>> {
+    use std::sync::{Condvar, Mutex};
+    let n = specs.len();
+    let refs: Vec<&StageContext> = ctxs.iter().collect();
+    let deps: Vec<Vec<usize>> = (0..n).map(|i| lanes::dependencies(specs, &refs, i)).collect();
+    let lanes = opts.lanes.min(n);
+    let threads = (crate::sweep::cores() / lanes).max(1);
+    let progress = indicatif::MultiProgress::new();
+    if crate::contract::quiet() {
+        progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    say(format!(
+        "{lanes} stages side by side with {threads} thread(s) each (a stage starts once those it reads have finished)"
+    ));
+    struct State {
+        started: Vec<bool>,
+        records: Vec<Option<StageRecord>>,
+        error: Option<anyhow::Error>,
+    }
+    let state = Mutex::new(State {
+        started: vec![false; n],
+        records: (0..n).map(|_| None).collect(),
+        error: None,
+    });
+    let wake = Condvar::new();
+    let lock = || state.lock().unwrap_or_else(|e| e.into_inner());
+    std::thread::scope(|scope| {
+        for _ in 0..lanes {
+            scope.spawn(|| {
+                let mut st = lock();
+                loop {
+                    if st.error.is_some() || st.started.iter().all(|&s| s) {
+                        return;
+                    }
+                    let ready =
+                        (0..n).find(|&i| !st.started[i] && deps[i].iter().all(|&j| st.records[j].is_some()));
+                    let Some(i) = ready else {
+                        st = wake.wait(st).unwrap_or_else(|e| e.into_inner());
+                        continue;
+                    };
+                    st.started[i] = true;
+                    drop(st);
+                    let mut ctx = ctxs[i].clone();
+                    ctx.share_progress(&progress);
+                    let result = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .context("cannot start a lane's thread pool")
+                        .and_then(|pool| pool.install(|| run_stage(ctx, specs[i], opts, say)))
+                        .and_then(|r| done(&ctxs[i], &r).map(|_| r));
+                    st = lock();
+                    match result {
+                        Ok(r) => st.records[i] = Some(r),
+                        Err(e) => {
+                            say(format!(
+                                "{:>12}  failed; the stages running finish, no other starts",
+                                specs[i].name
+                            ));
+                            if st.error.is_none() {
+                                st.error = Some(e);
+                            }
+                        }
+                    }
+                    wake.notify_all();
+                }
+            });
+        }
+    });
+    let st = state.into_inner().unwrap_or_else(|e| e.into_inner());
+    if let Some(e) = st.error {
+        return Err(e);
+    }
+    Ok(st.records.into_iter().flatten().collect())
 }
 
 #[cfg(test)]

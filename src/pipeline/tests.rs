@@ -336,3 +336,40 @@ fn a_failed_resume_of_a_run_without_a_checkpoint_leaves_no_directory() {
     assert!(execute(resumable_stage(&input, params, true), &ctx).is_err());
     assert!(!ctx.out_dir.exists(), "an empty output directory was left behind");
 }
+
+/// What `lbdem run --lanes` waits for, on the quickstart pipeline: a stage waits for the stages
+/// its parameters name (by name, `@name/...` or `from_stage`), the report for all before it,
+/// and the shear run for nothing.
+#[test]
+fn a_stage_waits_for_the_stages_it_names() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("pipelines/quickstart.toml");
+    let p = schema::Pipeline::load(&path).unwrap();
+    let out = p.out_dir();
+    let mut earlier = Vec::new();
+    let ctxs: Vec<StageContext> = p
+        .stages
+        .iter()
+        .map(|s| {
+            let mut c = StageContext::new(out.join(&s.name), s.name.clone(), p.root.clone());
+            c.earlier = earlier.clone();
+            earlier.push((s.name.clone(), out.join(&s.name)));
+            c
+        })
+        .collect();
+    let specs: Vec<_> = p.stages.iter().collect();
+    let refs: Vec<_> = ctxs.iter().collect();
+    let names = |i: usize| -> Vec<&str> {
+        lanes::dependencies(&specs, &refs, i)
+            .into_iter()
+            .map(|j| specs[j].name.as_str())
+            .collect()
+    };
+    let at = |n: &str| specs.iter().position(|s| s.name == n).unwrap();
+    assert_eq!(names(at("radiograph")), Vec::<&str>::new());
+    assert_eq!(names(at("digitise")), ["radiograph"]);
+    assert_eq!(names(at("shear")), Vec::<&str>::new());
+    assert_eq!(names(at("analyse")), ["shear"]);
+    assert_eq!(names(at("run-radiograph-maps")), ["run-radiographs"]);
+    assert_eq!(names(at("compare")), ["shear", "run-radiograph-maps"]);
+    assert_eq!(names(at("report")).len(), specs.len() - 1);
+}

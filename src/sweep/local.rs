@@ -70,6 +70,7 @@ pub fn run_case(case: &Case, o: &CaseOpts) -> Outcome {
                 RunOpts {
                     force: o.force,
                     quiet: true,
+                    lanes: 1,
                 },
             )
         })

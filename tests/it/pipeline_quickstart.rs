@@ -77,3 +77,59 @@ fn quickstart_report_cache_and_force() {
     assert!(ok, "forced run failed:\n{err}");
     assert_eq!(err.matches("unchanged, skipped").count(), 0, "{err}");
 }
+
+/// Every file under `dir` but the records of how and when it was made (stage manifests,
+/// provenance, the report page that prints them), by path relative to `dir`.
+fn outputs(dir: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
+    let mut files = std::collections::BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            if p.is_dir() {
+                todo.push(p);
+            } else if !["stage.json", "provenance.json", "index.html", "summary.json"]
+                .contains(&name.as_str())
+            {
+                files.insert(
+                    p.strip_prefix(dir).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    files
+}
+
+/// `lbdem run --lanes 2`: the shear run goes beside the radiograph and digitise stages (it reads
+/// neither), the analyses wait for it, and every file written is the one a run in one lane
+/// writes, byte for byte.
+#[test]
+fn quickstart_in_two_lanes_writes_what_one_lane_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("reports");
+    let pipeline = redirected_pipeline(dir.path(), &out);
+    let mut files = Vec::new();
+    for lanes in ["1", "2"] {
+        // The same output directory for both (the analysis records the run's path), emptied.
+        let _ = std::fs::remove_dir_all(&out);
+        let (ok, err) = run(&["run", pipeline.to_str().unwrap(), "--lanes", lanes]);
+        assert!(ok, "--lanes {lanes} failed:\n{err}");
+        if lanes == "2" {
+            assert!(err.contains("2 stages side by side"), "{err}");
+        }
+        files.push(outputs(&out));
+    }
+    assert!(files[0].len() > 20, "{} files", files[0].len());
+    assert_eq!(
+        files[0].keys().collect::<Vec<_>>(),
+        files[1].keys().collect::<Vec<_>>(),
+        "the two runs wrote different files"
+    );
+    for (path, bytes) in &files[0] {
+        assert!(&files[1][path] == bytes, "{} differs", path.display());
+    }
+    let (ok, err) = run(&["run", "pipelines/quickstart.toml", "--lanes", "0"]);
+    assert!(!ok && err.contains("--lanes"), "{err}");
+}

@@ -228,7 +228,12 @@ impl<T: Real> CoupledModel<T> {
                 lbdem_core::simd::level().name()
             );
         }
-        let threads = s.run.threads;
+        // `threads = 0` takes the pool the model is built in (`scenes::run::run`'s: all cores
+        // alone, a lane's or a sweep case's share beside others), not every core.
+        let threads = match s.run.threads {
+            0 => rayon::current_num_threads(),
+            n => n,
+        };
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
