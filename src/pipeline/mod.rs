@@ -345,6 +345,9 @@ fn run_planned(
         records
     };
     let mut prov = prov.into_inner().unwrap_or_else(|e| e.into_inner());
+    // Stages side by side finish in any order; the record lists them in the file's.
+    prov.stages
+        .sort_by_key(|st| pipeline.stages.iter().position(|s| s.name == st.name));
     prov.total_wall_s = t_all.elapsed().as_secs_f64();
     prov.write(&out)?;
     say(format!(
@@ -441,12 +444,22 @@ fn side_by_side(
                     drop(st);
                     let mut ctx = ctxs[i].clone();
                     ctx.share_progress(&progress);
-                    let result = rayon::ThreadPoolBuilder::new()
-                        .num_threads(threads)
-                        .build()
-                        .context("cannot start a lane's thread pool")
-                        .and_then(|pool| pool.install(|| run_stage(ctx, specs[i], opts, say)))
-                        .and_then(|r| done(&ctxs[i], &r).map(|_| r));
+                    // A panic outside `execute`'s own guard would leave the other lanes
+                    // waiting for this stage: it becomes this stage's error.
+                    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        rayon::ThreadPoolBuilder::new()
+                            .num_threads(threads)
+                            .build()
+                            .context("cannot start a lane's thread pool")
+                            .and_then(|pool| pool.install(|| run_stage(ctx, specs[i], opts, say)))
+                            .and_then(|r| done(&ctxs[i], &r).map(|_| r))
+                    }))
+                    .unwrap_or_else(|_| {
+                        Err(anyhow::anyhow!(
+                            "stage '{}' stopped on an internal error (a bug in lbdem; please report it)",
+                            specs[i].name
+                        ))
+                    });
                     st = lock();
                     match result {
                         Ok(r) => st.records[i] = Some(r),
