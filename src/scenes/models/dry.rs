@@ -203,7 +203,7 @@ impl Model for Dry {
     fn warnings(&self) -> Vec<String> {
         self.cell
             .as_ref()
-            .map_or_else(Vec::new, |c| c.warnings(self.params.dt))
+            .map_or_else(Vec::new, |c| c.warnings(&self.sys, self.params.dt))
     }
     fn describe(&self) -> serde_json::Value {
         serde_json::json!({

@@ -15,7 +15,7 @@ use crate::scenes::build::dem::wall_anchor;
 use crate::scenes::run::wall_index;
 use crate::scenes::schema::Scene;
 use anyhow::{Result, bail};
-use lbdem_dem::polygon::{plate_region, sample_area};
+use lbdem_dem::polygon::{contains, plate_region, sample_area};
 use lbdem_dem::{Stepper, System, Vec2, Vector, WallMotion};
 
 pub const COLUMNS: [&str; 9] = [
@@ -41,6 +41,8 @@ pub struct ShearCell {
     speed: f64,
     /// Membrane members in ring order.
     order: Vec<usize>,
+    /// Whether each body is a membrane member.
+    member: Vec<bool>,
     /// γ̇ of Eq. 20 (1/s).
     shear_rate: f64,
     /// Mean equivalent-area grain diameter d̄ (m).
@@ -127,6 +129,10 @@ impl ShearCell {
             );
         }
         let b = &sys.bodies;
+        let mut member = vec![false; b.len()];
+        for &k in &mem.bodies {
+            member[k as usize] = true;
+        }
         let n = b.len().max(1) as f64;
         let d_mean = (0..b.len())
             .map(|k| (4.0 * b.mass[k] / b.density[k] / std::f64::consts::PI).sqrt())
@@ -137,9 +143,27 @@ impl ShearCell {
             dir: v * (1.0 / v.norm()),
             speed: v.norm(),
             order: mem.ring_order(),
+            member,
             shear_rate: v.norm() / sc.shear_length,
             d_mean,
         }))
+    }
+
+    /// The largest speed of the sample's grains (m/s): [`fastest_inside`] the membrane.
+    pub fn fastest_in_sample(&self, sys: &System) -> f64 {
+        match &sys.membrane {
+            Some(mem) => fastest_inside(&sys.bodies, &mem.polygon(&self.order, &sys.bodies), &self.member),
+            None => sys.bodies.max_speed(),
+        }
+    }
+
+    /// Grains outside the polygon through the membrane's centroids: they left the sample.
+    pub fn escaped(&self, sys: &System) -> usize {
+        let Some(mem) = &sys.membrane else { return 0 };
+        let ring = mem.polygon(&self.order, &sys.bodies);
+        (0..sys.bodies.len())
+            .filter(|&k| !self.member[k] && !contains(&ring, sys.bodies.pos[k]))
+            .count()
     }
 
     /// A_def of Eq. 18 (m²).
@@ -224,7 +248,7 @@ impl ShearCell {
             (a / a0).ln(),
             p,
             self.inertial_number(p, Self::density(sys)),
-            sys.bodies.max_speed(),
+            self.fastest_in_sample(sys),
         ]
     }
 }
@@ -324,7 +348,7 @@ impl Tracked {
         if h.released.is_some() {
             return false;
         }
-        let fastest = sys.bodies.max_speed();
+        let fastest = self.cell.fastest_in_sample(sys);
         // `==` at the last step: a checkpoint of a fixed hold written before `released` was
         // kept restores with none, and must not be let go a second time.
         let go = steps == h.last || (steps >= h.until && h.rest_speed.is_some_and(|v| fastest < v));
@@ -360,22 +384,33 @@ impl Tracked {
         self.hold.and_then(|h| h.released)
     }
 
-    /// A settling to rest that ran out of time: the plate was let go with grains still moving
-    /// faster than the criterion, so what is sheared is a sample still relaxing.
-    pub fn warnings(&self, dt: f64) -> Vec<String> {
+    /// Grains that left the sample through the membrane, and a settling to rest that ran out of
+    /// time: the plate was let go with grains still moving faster than the criterion, so what
+    /// is sheared is a sample still relaxing.
+    pub fn warnings(&self, sys: &System, dt: f64) -> Vec<String> {
+        let mut w = Vec::new();
+        let escaped = self.cell.escaped(sys);
+        if escaped > 0 {
+            w.push(format!(
+                "[shear_cell]: {escaped} grain(s) lie outside the membrane at the end (they left the sample \
+                 through it, and ε_vol^DEM and the liquid no longer see them); a membrane pushed out this far \
+                 needs a larger [membrane] force or a looser assembly"
+            ));
+        }
         let Some(h) = self.hold else {
-            return Vec::new();
+            return w;
         };
         match (h.rest_speed, h.released) {
-            (Some(v), Some(r)) if r.fastest_grain >= v => vec![format!(
+            (Some(v), Some(r)) if r.fastest_grain >= v => w.push(format!(
                 "[shear_cell] settle_until_rest: the plate was let go at max_time = {:.3} s with the fastest grain \
                  at {:.2e} m/s, above speed = {v:e} m/s: the sample was still relaxing when the shear began; \
                  raise max_time",
                 h.last as f64 * dt,
                 r.fastest_grain
-            )],
-            _ => Vec::new(),
+            )),
+            _ => {}
         }
+        w
     }
     pub fn sample(&self, sys: &System, st: &Stepper, steps: u64) -> Vec<f64> {
         self.cell
@@ -401,6 +436,31 @@ impl Tracked {
         }
         let u = self.cell.displacement(sys, self.start);
         format!("u_y = {:.2} d̄", u / self.cell.d_mean)
+    }
+}
+
+/// The largest speed (m/s) of the bodies that are `member`s of the ring or lie inside it. A
+/// grain that has left through the membrane (one did in the 95 %PK settling, drifting on at
+/// 5.7e-5 m/s outside the lattice, where nothing slows it) is not the sample's and would keep a
+/// settling to rest from ending. The fastest bodies are tried first, so the ring is searched
+/// once per escaped grain faster than the answer.
+pub fn fastest_inside(b: &lbdem_dem::Bodies, ring: &[Vec2], member: &[bool]) -> f64 {
+    let mut outside: Vec<usize> = Vec::new();
+    loop {
+        let fastest = (0..b.len())
+            .filter(|k| !outside.contains(k))
+            .map(|k| (k, b.vel[k].norm2()))
+            .fold(None, |m: Option<(usize, f64)>, (k, v)| match m {
+                Some((_, w)) if w >= v => m,
+                _ => Some((k, v)),
+            });
+        let Some((k, v2)) = fastest else {
+            return 0.0;
+        };
+        if member[k] || contains(ring, b.pos[k]) {
+            return v2.sqrt();
+        }
+        outside.push(k);
     }
 }
 
@@ -431,5 +491,40 @@ pub fn wall_displacement(
     match cell {
         Some(c) => c.probe_displacement(k, steps, d),
         None => Some(d),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lbdem_dem::{Bodies, ClumpShape};
+
+    /// A square ring of four members, a slow grain inside and a fast one outside: the sample's
+    /// fastest is the inside grain's speed, or a member's when that is faster; with the outside
+    /// grain inside, its own.
+    #[test]
+    fn the_sample_s_fastest_grain_leaves_out_those_outside_the_membrane() {
+        let mut b = Bodies::new();
+        let disk = ClumpShape::disk(1e-4);
+        for (x, y) in [
+            (0.0, 0.0),
+            (1e-3, 0.0),
+            (1e-3, 1e-3),
+            (0.0, 1e-3),
+            (5e-4, 5e-4),
+            (3e-3, 5e-4),
+        ] {
+            b.add(&disk, 1.0, Vec2::new(x, y), 0.0).unwrap();
+        }
+        b.vel[4] = Vec2::new(2e-7, 0.0);
+        b.vel[5] = Vec2::new(0.0, 5e-5);
+        let ring: Vec<Vec2> = (0..4).map(|k| b.pos[k]).collect();
+        let member = [true, true, true, true, false, false];
+        assert_eq!(fastest_inside(&b, &ring, &member), 2e-7);
+        b.vel[2] = Vec2::new(-3e-7, 0.0);
+        assert_eq!(fastest_inside(&b, &ring, &member), 3e-7);
+        b.pos[5] = Vec2::new(6e-4, 4e-4);
+        assert_eq!(fastest_inside(&b, &ring, &member), 5e-5);
+        assert_eq!(b.max_speed(), 5e-5);
     }
 }
