@@ -406,7 +406,8 @@ fn side_by_side(
     let refs: Vec<&StageContext> = ctxs.iter().collect();
     let deps: Vec<Vec<usize>> = (0..n).map(|i| lanes::dependencies(specs, &refs, i)).collect();
     let lanes = opts.lanes.min(n);
-    let threads = (crate::sweep::cores() / lanes).max(1);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = (cores / lanes).max(1);
     let progress = indicatif::MultiProgress::new();
     if crate::contract::quiet() {
         progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
