@@ -348,16 +348,24 @@ impl Tracked {
         if h.released.is_some() {
             return false;
         }
-        let fastest = self.cell.fastest_in_sample(sys);
         // `==` at the last step: a checkpoint of a fixed hold written before `released` was
-        // kept restores with none, and must not be let go a second time.
-        let go = steps == h.last || (steps >= h.until && h.rest_speed.is_some_and(|v| fastest < v));
-        if !go {
-            return false;
-        }
+        // kept restores with none, and must not be let go a second time. The speeds are read
+        // only where they decide (a dry model's step is one DEM step).
+        let resting = match h.rest_speed {
+            Some(v) if steps >= h.until => {
+                let fastest = self.cell.fastest_in_sample(sys);
+                (fastest < v).then_some(fastest)
+            }
+            _ => None,
+        };
+        let fastest_grain = match resting {
+            Some(f) => f,
+            None if steps == h.last => self.cell.fastest_in_sample(sys),
+            None => return false,
+        };
         h.released = Some(Release {
             step: steps,
-            fastest_grain: fastest,
+            fastest_grain,
         });
         sys.walls[self.cell.plate].vel = h.velocity;
         self.start = self.cell.plate_anchor(sys);
@@ -377,11 +385,6 @@ impl Tracked {
         if let Some(h) = &mut self.hold {
             h.released = o.released;
         }
-    }
-
-    /// When the plate was let go (None while held, or without a settling).
-    pub fn released(&self) -> Option<Release> {
-        self.hold.and_then(|h| h.released)
     }
 
     /// Grains that left the sample through the membrane, and a settling to rest that ran out of
