@@ -543,21 +543,14 @@ impl<T: Real> Model for CoupledModel<T> {
             self.su.lo[0] + self.su.n[0] as f64 * dx,
             self.su.lo[1] + self.su.n[1] as f64 * dx,
         ];
-        if let Some(mem) = &self.run.sys.membrane {
-            let out = mem
-                .bodies
-                .iter()
-                .map(|&k| self.run.sys.bodies.pos[k as usize])
-                .filter(|p| p.x < self.su.lo[0] || p.y < self.su.lo[1] || p.x > hi[0] || p.y > hi[1])
-                .count();
-            if out > 0 {
-                w.push(format!(
-                    "[shear_cell]: {out} membrane grain(s) lie outside the lattice [{:.3e}, {:.3e}] x [{:.3e}, {:.3e}] m \
-                     at the end: the liquid there is confined by the lattice's faces, not by the membrane; \
-                     widen [domain]",
-                    self.su.lo[0], hi[0], self.su.lo[1], hi[1]
-                ));
-            }
+        let out = shear_cell::ShearCell::membrane_outside(&self.run.sys, [self.su.lo[0], self.su.lo[1]], hi);
+        if out > 0 {
+            w.push(format!(
+                "[shear_cell]: {out} membrane grain(s) lie outside the lattice [{:.3e}, {:.3e}] x [{:.3e}, {:.3e}] m \
+                 at the end: the liquid there is confined by the lattice's faces, not by the membrane; \
+                 widen [domain]",
+                self.su.lo[0], hi[0], self.su.lo[1], hi[1]
+            ));
         }
         w
     }

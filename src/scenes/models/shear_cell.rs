@@ -160,9 +160,16 @@ impl ShearCell {
     /// Grains outside the polygon through the membrane's centroids: they left the sample.
     pub fn escaped(&self, sys: &System) -> usize {
         let Some(mem) = &sys.membrane else { return 0 };
-        let ring = mem.polygon(&self.order, &sys.bodies);
-        (0..sys.bodies.len())
-            .filter(|&k| !self.member[k] && !contains(&ring, sys.bodies.pos[k]))
+        outside_ring(&sys.bodies, &mem.polygon(&self.order, &sys.bodies), &self.member)
+    }
+
+    /// Membrane grains whose centroid lies outside the box `lo`-`hi` (a coupled run's lattice).
+    pub fn membrane_outside(sys: &System, lo: [f64; 2], hi: [f64; 2]) -> usize {
+        let Some(mem) = &sys.membrane else { return 0 };
+        mem.bodies
+            .iter()
+            .map(|&k| sys.bodies.pos[k as usize])
+            .filter(|p| p.x < lo[0] || p.y < lo[1] || p.x > hi[0] || p.y > hi[1])
             .count()
     }
 
@@ -467,6 +474,13 @@ pub fn fastest_inside(b: &lbdem_dem::Bodies, ring: &[Vec2], member: &[bool]) -> 
     }
 }
 
+/// The bodies neither `member`s of the ring nor inside it.
+pub fn outside_ring(b: &lbdem_dem::Bodies, ring: &[Vec2], member: &[bool]) -> usize {
+    (0..b.len())
+        .filter(|&k| !member[k] && !contains(ring, b.pos[k]))
+        .count()
+}
+
 /// `[shear_cell] settle` in steps of `dt`, and the longest hold (`settle_until_rest.max_time`,
 /// else the same); None without a settling or without `[shear_cell]`.
 pub fn settle_steps(s: &Scene, dt: f64) -> Option<(u64, u64)> {
@@ -500,7 +514,7 @@ pub fn wall_displacement(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lbdem_dem::{Bodies, ClumpShape};
+    use lbdem_dem::{Bodies, ClumpShape, Domain, Membrane};
 
     /// A square ring of four members, a slow grain inside and a fast one outside: the sample's
     /// fastest is the inside grain's speed, or a member's when that is faster; with the outside
@@ -524,10 +538,24 @@ mod tests {
         let ring: Vec<Vec2> = (0..4).map(|k| b.pos[k]).collect();
         let member = [true, true, true, true, false, false];
         assert_eq!(fastest_inside(&b, &ring, &member), 2e-7);
+        assert_eq!(outside_ring(&b, &ring, &member), 1);
         b.vel[2] = Vec2::new(-3e-7, 0.0);
         assert_eq!(fastest_inside(&b, &ring, &member), 3e-7);
         b.pos[5] = Vec2::new(6e-4, 4e-4);
         assert_eq!(fastest_inside(&b, &ring, &member), 5e-5);
+        assert_eq!(outside_ring(&b, &ring, &member), 0);
         assert_eq!(b.max_speed(), 5e-5);
+        // The ring's members against a lattice box: the two at x = 1 mm lie past a face at 0.9.
+        let members = Membrane::new(vec![0, 1, 2, 3], &b, 5e-5, 1e-9);
+        let mut sys = System::new(b, Domain::open(Vec2::new(-1e-2, -1e-2), Vec2::new(1e-2, 1e-2)));
+        sys.membrane = Some(members);
+        assert_eq!(
+            ShearCell::membrane_outside(&sys, [-1e-4, -1e-4], [1.1e-3, 1.1e-3]),
+            0
+        );
+        assert_eq!(
+            ShearCell::membrane_outside(&sys, [-1e-4, -1e-4], [0.9e-3, 1.1e-3]),
+            2
+        );
     }
 }
