@@ -41,6 +41,12 @@ pub fn quiet() -> bool {
     QUIET.load(std::sync::atomic::Ordering::Relaxed)
 }
 
+/// The cores of this machine (or of this rank's share of it): what a sweep's cases and a
+/// pipeline's lanes share out.
+pub fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// A progress bar of `len` steps: drawn on a terminal, hidden when [`quiet`].
 pub fn progress_bar(len: u64) -> ProgressBar {
     if quiet() {

@@ -406,8 +406,7 @@ fn side_by_side(
     let refs: Vec<&StageContext> = ctxs.iter().collect();
     let deps: Vec<Vec<usize>> = (0..n).map(|i| lanes::dependencies(specs, &refs, i)).collect();
     let lanes = opts.lanes.min(n);
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let threads = (cores / lanes).max(1);
+    let threads = (crate::contract::cores() / lanes).max(1);
     let progress = indicatif::MultiProgress::new();
     if crate::contract::quiet() {
         progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
@@ -445,21 +444,8 @@ fn side_by_side(
                     drop(st);
                     let mut ctx = ctxs[i].clone();
                     ctx.share_progress(&progress);
-                    // A panic outside `execute`'s own guard would leave the other lanes
-                    // waiting for this stage: it becomes this stage's error.
-                    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                        rayon::ThreadPoolBuilder::new()
-                            .num_threads(threads)
-                            .build()
-                            .context("cannot start a lane's thread pool")
-                            .and_then(|pool| pool.install(|| run_stage(ctx, specs[i], opts, say)))
-                            .and_then(|r| done(&ctxs[i], &r).map(|_| r))
-                    }))
-                    .unwrap_or_else(|_| {
-                        Err(anyhow::anyhow!(
-                            "stage '{}' stopped on an internal error (a bug in lbdem; please report it)",
-                            specs[i].name
-                        ))
+                    let result = in_lane(threads, &specs[i].name, || {
+                        run_stage(ctx, specs[i], opts, say).and_then(|r| done(&ctxs[i], &r).map(|_| r))
                     });
                     st = lock();
                     match result {
@@ -484,6 +470,27 @@ fn side_by_side(
         return Err(e);
     }
     Ok(st.records.into_iter().flatten().collect())
+}
+
+/// `work` in a rayon pool of `threads` threads of its own. A panic outside `execute`'s own guard
+/// becomes an error: left to unwind, it would leave the other lanes waiting for this stage.
+fn in_lane(
+    threads: usize,
+    name: &str,
+    work: impl FnOnce() -> Result<StageRecord> + Send,
+) -> Result<StageRecord> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .context("cannot start a lane's thread pool")?
+            .install(work)
+    }))
+    .unwrap_or_else(|_| {
+        Err(anyhow::anyhow!(
+            "stage '{name}' stopped on an internal error (a bug in lbdem; please report it)"
+        ))
+    })
 }
 
 #[cfg(test)]

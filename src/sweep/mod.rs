@@ -70,10 +70,7 @@ pub fn slots(cases: usize, cores: usize, parallel: usize, threads: usize) -> Res
     Ok((p, t))
 }
 
-/// The cores of this machine (or of this rank's share of it).
-pub fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
-}
+pub use crate::contract::cores;
 
 /// Whether this process was started by an MPI launcher (mpirun, mpiexec, srun with PMI).
 pub fn launched_by_mpi() -> bool {
