@@ -183,6 +183,30 @@ pub struct RelaxParams {
     /// until it hits a neighbour, and this stops it.
     #[serde(default)]
     pub viscous_damping: Option<f64>,
+    /// Where the assembly relaxes (`"walls"` by default).
+    #[serde(default, skip_serializing_if = "Inside::is_walls")]
+    pub inside: Inside,
+}
+
+/// Where the assembly relaxes before the run (Su Sect. 2.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Inside {
+    /// Inside the sample's walls, with the compression's law and step, the target packing
+    /// fraction reached before and the membrane put on after (the sample then starts with an
+    /// unstressed membrane and the contact forces the target left).
+    #[default]
+    Walls,
+    /// Su's order: the membrane and push-plate put on the compressed sample, relaxation under
+    /// the run's law and step until every grain is slower than `threshold`, then the target
+    /// packing fraction reached inside the relaxed membrane (its area as it is then).
+    Membrane,
+}
+
+impl Inside {
+    fn is_walls(&self) -> bool {
+        *self == Inside::Walls
+    }
 }
 
 impl Default for RelaxParams {
@@ -192,6 +216,7 @@ impl Default for RelaxParams {
             max_steps: d_max_steps(),
             local_damping: 0.0,
             viscous_damping: None,
+            inside: Inside::Walls,
         }
     }
 }

@@ -98,15 +98,37 @@ pub struct PackingChange {
     pub added: usize,
 }
 
-/// Reach packing fraction `target` (grain area over the area of the box [lo, hi], the sample)
-/// by `method`. `small` is the shape added in interstices of the box (Su: "smaller grains");
-/// `max_size_change` bounds the first size scaling of [`PackingMethod::Auto`] (e.g. 0.03: ±3 %).
-/// Deleting grains renumbers them: bonds and the membrane are dropped (install them after).
+/// The sample a packing fraction refers to: the grains' area over `area`. Grains are added in
+/// interstices of the box [lo, hi] and, with a `ring` (a membrane's polygon), inside the ring.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample<'a> {
+    pub lo: Vec2,
+    pub hi: Vec2,
+    pub area: f64,
+    pub ring: Option<&'a [Vec2]>,
+}
+
+impl Sample<'_> {
+    /// The box [lo, hi] itself (a sample inside walls).
+    pub fn boxed(lo: Vec2, hi: Vec2) -> Self {
+        Self {
+            lo,
+            hi,
+            area: (hi.x - lo.x) * (hi.y - lo.y),
+            ring: None,
+        }
+    }
+}
+
+/// Reach packing fraction `target` (grain area over the sample's area) by `method`. `small` is
+/// the shape added in interstices (Su: "smaller grains"); `max_size_change` bounds the first
+/// size scaling of [`PackingMethod::Auto`] (e.g. 0.03: ±3 %). Membrane grains (tag 1) are never
+/// deleted; deleting grains renumbers them, so bonds and the membrane are dropped (install them
+/// after, on the grains tagged 1).
 #[allow(clippy::too_many_arguments)]
 pub fn adjust_packing(
     sys: &mut System,
-    lo: Vec2,
-    hi: Vec2,
+    sample: &Sample,
     target: f64,
     method: PackingMethod,
     max_size_change: f64,
@@ -121,7 +143,7 @@ pub fn adjust_packing(
             why: "must lie in (0, 1)",
         });
     }
-    let area = (hi.x - lo.x) * (hi.y - lo.y);
+    let area = sample.area;
     let phi = |sys: &System| sys.bodies.total_area() / area;
     let from = phi(sys);
     let mut change = PackingChange {
@@ -170,7 +192,7 @@ pub fn adjust_packing(
         sys.membrane = None;
     }
     if add {
-        change.added = add_until(sys, lo, hi, target, small, density, seed)?;
+        change.added = add_until(sys, sample, target, small, density, seed)?;
     }
     let s = (target / phi(sys)).sqrt();
     scale(sys, s, &mut change);
@@ -179,7 +201,8 @@ pub fn adjust_packing(
     Ok(change)
 }
 
-/// Delete grains in a seeded random order until their area over `area` is at most `target`.
+/// Delete grains in a seeded random order until their area over `area` is at most `target`;
+/// membrane grains (tag 1) stay.
 fn delete_until(sys: &mut System, area: f64, target: f64, seed: u64) -> usize {
     let n = sys.bodies.len();
     let mut order: Vec<usize> = (0..n).collect();
@@ -194,6 +217,9 @@ fn delete_until(sys: &mut System, area: f64, target: f64, seed: u64) -> usize {
         if left / area <= target {
             break;
         }
+        if sys.bodies.tag[k] == 1 {
+            continue;
+        }
         drop[k] = true;
         left -= sys.bodies.mass[k] / sys.bodies.density[k];
         deleted += 1;
@@ -205,14 +231,13 @@ fn delete_until(sys: &mut System, area: f64, target: f64, seed: u64) -> usize {
 /// Add copies of `small` in interstices until the packing fraction is at least `target`.
 fn add_until(
     sys: &mut System,
-    lo: Vec2,
-    hi: Vec2,
+    sample: &Sample,
     target: f64,
     small: &ClumpShape<Vec2>,
     density: f64,
     seed: u64,
 ) -> Result<usize, DemError> {
-    let area = (hi.x - lo.x) * (hi.y - lo.y);
+    let (lo, hi, area) = (sample.lo, sample.hi, sample.area);
     let (shape, _) = small.centred()?;
     let br = shape.bounding_radius();
     let mut r = rng(seed ^ 0x5eed_add0);
@@ -255,16 +280,20 @@ fn add_until(
             .iter()
             .map(|b| (at + b.centre.rotated(ang), b.r))
             .collect();
-        let clash = mine.iter().any(|&(p, rr)| {
-            let (i, j) = at_cell(p);
-            (j.saturating_sub(1)..=(j + 1).min(ny - 1)).any(|jj| {
-                (i.saturating_sub(1)..=(i + 1).min(nx - 1)).any(|ii| {
-                    grid[jj * nx + ii]
-                        .iter()
-                        .any(|&(q, rq)| (p - q).norm2() < (rr + rq).powi(2))
+        let outside = sample
+            .ring
+            .is_some_and(|ring| mine.iter().any(|&(p, _)| !crate::polygon::contains(ring, p)));
+        let clash = outside
+            || mine.iter().any(|&(p, rr)| {
+                let (i, j) = at_cell(p);
+                (j.saturating_sub(1)..=(j + 1).min(ny - 1)).any(|jj| {
+                    (i.saturating_sub(1)..=(i + 1).min(nx - 1)).any(|ii| {
+                        grid[jj * nx + ii]
+                            .iter()
+                            .any(|&(q, rq)| (p - q).norm2() < (rr + rq).powi(2))
+                    })
                 })
-            })
-        });
+            });
         if !clash {
             sys.bodies.add(&shape, density, at, ang)?;
             for &(p, rr) in &mine {
@@ -332,6 +361,13 @@ pub struct MembraneSpec {
 /// Existing bonds are replaced.
 pub fn install_membrane(sys: &mut System, m: &MembraneSpec) {
     let members = shell_members(&sys.bodies, m.shell);
+    install_membrane_on(sys, members, m);
+}
+
+/// [`install_membrane`] on given grains (e.g. those tagged 1 after a packing change inside a
+/// membrane that has deformed, where the outline's shell would pick others): their bonds made
+/// afresh as they now lie, and the outward displacement of F_N counted from here.
+pub fn install_membrane_on(sys: &mut System, members: Vec<u32>, m: &MembraneSpec) {
     for t in sys.bodies.tag.iter_mut() {
         *t = 0;
     }
@@ -417,8 +453,7 @@ mod tests {
             let mut s = grid_of_disks(10, 0.4, 1.0);
             let c = adjust_packing(
                 &mut s,
-                Vec2::ZERO,
-                Vec2::new(10.0, 10.0),
+                &Sample::boxed(Vec2::ZERO, Vec2::new(10.0, 10.0)),
                 target,
                 method,
                 0.03,
@@ -458,8 +493,7 @@ mod tests {
         };
         let c = adjust_packing(
             &mut s,
-            Vec2::ZERO,
-            Vec2::new(6.0, 6.0),
+            &Sample::boxed(Vec2::ZERO, Vec2::new(6.0, 6.0)),
             0.66,
             PackingMethod::Add,
             0.0,
@@ -485,13 +519,111 @@ mod tests {
     }
 
     #[test]
+    fn inside_a_membrane_its_grains_stay_and_added_grains_go_inside_its_ring() {
+        // 8 x 8 disks on a unit grid; the outer ring of 28 is the membrane (tag 1); the sample
+        // is the polygon through its centres, [0.5, 7.5]², area 49.
+        let mut s = grid_of_disks(8, 0.45, 1.0);
+        let edge = |p: Vec2| p.x < 1.0 || p.x > 7.0 || p.y < 1.0 || p.y > 7.0;
+        for k in 0..s.bodies.len() {
+            s.bodies.tag[k] = edge(s.bodies.pos[k]) as u32;
+        }
+        let ring = [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(7.5, 0.5),
+            Vec2::new(7.5, 7.5),
+            Vec2::new(0.5, 7.5),
+        ];
+        let sample = Sample {
+            lo: Vec2::ZERO,
+            hi: Vec2::new(8.0, 8.0),
+            area: 49.0,
+            ring: Some(&ring),
+        };
+        let from = s.bodies.total_area() / 49.0; // 64 π 0.45² / 49 = 0.831
+        let c = adjust_packing(
+            &mut s,
+            &sample,
+            0.3,
+            PackingMethod::Delete,
+            0.0,
+            &ClumpShape::disk(0.1),
+            1.0,
+            5,
+        )
+        .unwrap();
+        assert!(
+            (c.from - from).abs() < 1e-12 && (c.to - 0.3).abs() < 1e-12,
+            "{c:?}"
+        );
+        // 0.831 -> 0.3 needs more than the 36 inner grains' share: all go, the 28 stay.
+        assert_eq!(s.bodies.tag.iter().filter(|&&t| t == 1).count(), 28);
+        let mut s = grid_of_disks(8, 0.3, 1.0);
+        let n = s.bodies.len();
+        let c = adjust_packing(
+            &mut s,
+            &sample,
+            0.5,
+            PackingMethod::Add,
+            0.0,
+            &ClumpShape::disk(0.1),
+            1.0,
+            5,
+        )
+        .unwrap();
+        assert!(c.added > 0);
+        // Without the ring some of them would land in the 0.5-wide band round it (a box of 8).
+        for k in n..s.bodies.len() {
+            assert!(
+                crate::polygon::contains(&ring, s.bodies.pos[k]),
+                "added grain {k} outside"
+            );
+        }
+    }
+
+    #[test]
     fn a_target_the_method_cannot_reach_is_refused() {
         let small = ClumpShape::disk(0.1);
         let mut s = grid_of_disks(4, 0.4, 1.0);
         let (lo, hi) = (Vec2::ZERO, Vec2::new(4.0, 4.0));
-        assert!(adjust_packing(&mut s, lo, hi, 0.7, PackingMethod::Delete, 0.0, &small, 1.0, 1).is_err());
-        assert!(adjust_packing(&mut s, lo, hi, 0.2, PackingMethod::Add, 0.0, &small, 1.0, 1).is_err());
-        assert!(adjust_packing(&mut s, lo, hi, 1.2, PackingMethod::Scale, 0.0, &small, 1.0, 1).is_err());
+        assert!(
+            adjust_packing(
+                &mut s,
+                &Sample::boxed(lo, hi),
+                0.7,
+                PackingMethod::Delete,
+                0.0,
+                &small,
+                1.0,
+                1
+            )
+            .is_err()
+        );
+        assert!(
+            adjust_packing(
+                &mut s,
+                &Sample::boxed(lo, hi),
+                0.2,
+                PackingMethod::Add,
+                0.0,
+                &small,
+                1.0,
+                1
+            )
+            .is_err()
+        );
+        assert!(
+            adjust_packing(
+                &mut s,
+                &Sample::boxed(lo, hi),
+                1.2,
+                PackingMethod::Scale,
+                0.0,
+                &small,
+                1.0,
+                1
+            )
+            .is_err()
+        );
     }
 
     #[test]

@@ -1,6 +1,9 @@
 //! The phases of the assembly protocol (Su et al. 2020 Sect. 2.4) as one resumable loop:
-//! compression by servo walls, then (fit to the sample, target packing fraction) relaxation
-//! inside the sample's walls, then the run's membrane and push-plate and the F_0 measure. The
+//! compression by servo walls, then either (fit to the sample, target packing fraction)
+//! relaxation inside the sample's walls and the run's membrane and push-plate after it, or, in
+//! Su's order (`[relax] inside = "membrane"`), the membrane and plate on the fitted sample,
+//! relaxation under the run's law, and the target packing fraction inside the membrane; then the
+//! F_0 measure. The
 //! state between chunks of steps is plain data (the DEM system and what was recorded),
 //! checkpointed as JSON; a fresh stepper continues it to the same bits (the stepper's results do
 //! not depend on when its list was built).
@@ -24,6 +27,7 @@ const CHUNK: u64 = 200;
 enum Phase {
     Compress,
     Relax,
+    RelaxInMembrane,
 }
 
 /// What the protocol did and measured (in `stage.json`'s summary and the checkpoint).
@@ -43,6 +47,13 @@ pub struct Record {
     pub relax_dt: f64,
     pub relax_steps: u64,
     pub max_speed: f64,
+    /// Relaxed inside the membrane: the area of the polygon through the membrane grains'
+    /// centroids when it went on (the sample was the box then), and the packing fraction the
+    /// relaxation left, before the target was reached.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ring_area_0: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relaxed_packing: Option<f64>,
     pub packing_fraction: f64,
     pub f_0: f64,
     pub contacts: usize,
@@ -68,8 +79,12 @@ pub struct Done {
 /// The run's scene, as far as the assembly needs it.
 struct Run {
     density: f64,
+    /// The elastic parts of the run's laws (F_0's measure) and the laws themselves (the
+    /// relaxation inside the membrane).
     law: Law,
     wall_law: Law,
+    full_law: Law,
+    full_wall_law: Law,
     walls: Vec<lbdem_dem::Wall>,
     membrane: Option<asm::MembraneSpec>,
     step: StepParams,
@@ -98,8 +113,10 @@ fn run_scene(p: &Params, ctx: &StageContext) -> Result<Run> {
         .step_params();
     Ok(Run {
         density: pc.density,
-        law: elastic(law),
-        wall_law: elastic(wall_law),
+        law: elastic(law.clone()),
+        wall_law: elastic(wall_law.clone()),
+        full_law: law,
+        full_wall_law: wall_law,
         walls: build::walls(s).with_context(|| format!("{}: [[walls]]", path.display()))?,
         membrane: build::membrane_spec(s),
         step,
@@ -214,6 +231,13 @@ fn compression(p: &Params, sys: &System) -> (f64, StepParams, Compression) {
 
 pub fn run(p: &Params, ctx: &StageContext) -> Result<Done> {
     let run = run_scene(p, ctx)?;
+    if p.relax.inside == super::Inside::Membrane && run.membrane.is_none() {
+        bail!(
+            "[relax] inside = \"membrane\": the run's scene {} has no [membrane] to relax in; give it one or \
+             relax inside the walls (inside = \"walls\")",
+            ctx.resolve(&p.scene).display()
+        );
+    }
     let (sys0, temps, rec0) = start(p, ctx, run.density * p.compress.mass_scale)?;
     let ck_path = ctx.out_dir.join(CHECKPOINT);
     let (mut phase, mut phase_steps, mut rec, mut sys) = if ctx.resume {
@@ -309,22 +333,41 @@ pub fn run(p: &Params, ctx: &StageContext) -> Result<Done> {
         generate::stop_servo(&mut sys);
         rec.compress_steps = phase_steps;
         rec.compressed_packing = sys.packing_fraction();
-        prepare_relax(p, &run, &temps, &mut sys, &mut rec)?;
-        phase = Phase::Relax;
+        phase = match p.relax.inside {
+            super::Inside::Walls => {
+                prepare_relax(p, &run, &temps, &mut sys, &mut rec)?;
+                Phase::Relax
+            }
+            super::Inside::Membrane => {
+                membrane_on_box(p, &run, &mut sys, &mut rec)?;
+                Phase::RelaxInMembrane
+            }
+        };
         phase_steps = 0;
         stepper = Stepper::new();
         save(phase, phase_steps, &rec, &sys)?;
         last_ck = Instant::now();
     }
-    // Relaxation with the compression's law inside the sample's walls, until every grain is
-    // slower than 1e-7 m/s (Su Sect. 2.4). Su relax inside the membrane; here that does not end
-    // (docs/su2020.md, "Assemblies"): with Table 1's law the sample sheds the compression's
-    // overlaps through contacts 2.5e6 times softer, a creep still at 8e-5 m/s after 1e5 steps
-    // on the 84 %PK case; with the compression's law the membrane's bonds, 1e7 times softer
-    // than the contacts, cannot hold the released overlaps and membrane grains fly off.
-    let law = &p.compress.contact;
-    let (crit, _, _) = Stepper::critical_time_step(&sys, law, law);
-    let mut sp = StepParams::new(p.compress.dt_factor * crit, rec_skin(&sys));
+    // Relaxation until every grain is slower than 1e-7 m/s (Su Sect. 2.4). Inside the walls
+    // with the compression's law and step (the default), or inside the membrane under the
+    // run's law and step. With the compression's law the membrane's bonds, 1e7 times softer
+    // than the contacts, cannot hold the released overlaps and membrane grains fly off; with
+    // Table 1's law the sample sheds the compression's overlaps by a creep (docs/su2020.md,
+    // "Assemblies").
+    let in_membrane = phase == Phase::RelaxInMembrane;
+    let (law, wall_law) = if in_membrane {
+        (&run.full_law, &run.full_wall_law)
+    } else {
+        (&p.compress.contact, &p.compress.contact)
+    };
+    let mut sp = if in_membrane {
+        let mut sp = run.step;
+        sp.gravity = Vec2::ZERO;
+        sp
+    } else {
+        let (crit, _, _) = Stepper::critical_time_step(&sys, law, law);
+        StepParams::new(p.compress.dt_factor * crit, rec_skin(&sys))
+    };
     sp.local_damping = p.relax.local_damping;
     sp.viscous_damping = p.relax.viscous_damping.unwrap_or(1e-3 / sp.dt);
     rec.relax_dt = sp.dt;
@@ -333,8 +376,12 @@ pub fn run(p: &Params, ctx: &StageContext) -> Result<Done> {
     loop {
         for _ in 0..CHUNK {
             stepper
-                .step(&sp, law, law, &mut sys)
-                .context("relaxation inside the sample's walls")?;
+                .step(&sp, law, wall_law, &mut sys)
+                .context(if in_membrane {
+                    "relaxation inside the membrane"
+                } else {
+                    "relaxation inside the sample's walls"
+                })?;
         }
         phase_steps += CHUNK;
         let v = sys.bodies.max_speed();
@@ -360,28 +407,26 @@ pub fn run(p: &Params, ctx: &StageContext) -> Result<Done> {
     pb.finish_and_clear();
     rec.relax_steps = phase_steps;
     rec.max_speed = sys.bodies.max_speed();
-    let (lo, hi) = (
-        Vec2::new(p.sample.lo[0], p.sample.lo[1]),
-        Vec2::new(p.sample.hi[0], p.sample.hi[1]),
-    );
-    rec.packing_fraction = sys.bodies.total_area() / ((hi.x - lo.x) * (hi.y - lo.y));
-    // The walls give way to the run's push-plate (held still) and membrane.
-    sys.walls = run
-        .walls
-        .iter()
-        .map(|w| lbdem_dem::Wall::new(w.shape, lbdem_dem::WallMotion::Fixed))
-        .collect();
-    let margin = 0.1 * (hi - lo).norm();
-    sys.domain = lbdem_dem::Domain::open(lo - Vec2::new(margin, margin), hi + Vec2::new(margin, margin));
-    // The run's masses, its membrane on the grains as they now lie, and F_0: the mean contact
-    // force of the run's elastic law on these overlaps (Table 1: U_0 = F_0 / k_n,e), from one
-    // force evaluation at rest.
-    sys.bodies.scale_mass(1.0 / p.compress.mass_scale);
-    match &run.membrane {
-        Some(m) => asm::install_membrane(&mut sys, m),
-        None => sys.membrane = None,
+    if in_membrane {
+        // "Different initial 2D packing fractions were then generated from this sample".
+        packing_in_membrane(p, &run, &temps, &mut sys, &mut rec)?;
+    } else {
+        let (lo, hi) = (
+            Vec2::new(p.sample.lo[0], p.sample.lo[1]),
+            Vec2::new(p.sample.hi[0], p.sample.hi[1]),
+        );
+        rec.packing_fraction = sys.bodies.total_area() / ((hi.x - lo.x) * (hi.y - lo.y));
+        // The walls give way to the run's push-plate (held still) and membrane, at the run's
+        // masses.
+        run_boundaries(p, &run, &mut sys);
+        match &run.membrane {
+            Some(m) => asm::install_membrane(&mut sys, m),
+            None => sys.membrane = None,
+        }
     }
     rec.membrane_grains = sys.membrane.as_ref().map_or(0, |m| m.bodies.len());
+    // F_0: the mean contact force of the run's elastic law on these overlaps (Table 1: U_0 =
+    // F_0 / k_n,e), from one force evaluation at rest.
     at_rest(&mut sys);
     let mut probe = sys.clone();
     let mut measure = Stepper::new();
@@ -404,6 +449,114 @@ pub fn run(p: &Params, ctx: &StageContext) -> Result<Done> {
     })
 }
 
+/// The sample's walls give way to the run's push-plate (held still) in an open domain, and the
+/// grains take the run's masses.
+fn run_boundaries(p: &Params, run: &Run, sys: &mut System) {
+    let (lo, hi) = (
+        Vec2::new(p.sample.lo[0], p.sample.lo[1]),
+        Vec2::new(p.sample.hi[0], p.sample.hi[1]),
+    );
+    sys.walls = run
+        .walls
+        .iter()
+        .map(|w| lbdem_dem::Wall::new(w.shape, lbdem_dem::WallMotion::Fixed))
+        .collect();
+    let margin = 0.1 * (hi - lo).norm();
+    sys.domain = lbdem_dem::Domain::open(lo - Vec2::new(margin, margin), hi + Vec2::new(margin, margin));
+    sys.bodies.scale_mass(1.0 / p.compress.mass_scale);
+}
+
+/// The area of the polygon through the membrane grains' centroids (Su Eq. 18's ring).
+fn ring_area(sys: &System) -> Option<(f64, Vec<Vec2>)> {
+    let m = sys.membrane.as_ref()?;
+    let ring = m.polygon(&m.ring_order(), &sys.bodies);
+    Some((lbdem_dem::polygon::signed_area(&ring).abs(), ring))
+}
+
+/// Su's order (Sect. 2.4): the compressed assembly fitted to the sample's box, the walls
+/// replaced by the run's membrane and push-plate at once, the grains at the run's masses.
+fn membrane_on_box(p: &Params, run: &Run, sys: &mut System, rec: &mut Record) -> Result<()> {
+    let (lo, hi) = (
+        Vec2::new(p.sample.lo[0], p.sample.lo[1]),
+        Vec2::new(p.sample.hi[0], p.sample.hi[1]),
+    );
+    rec.fit = asm::fit_to_box(sys, lo, hi)?;
+    let m = run.membrane.as_ref().context(
+        "[relax] inside = \"membrane\": the run's scene has no [membrane]; relax inside the walls (inside = \"walls\")",
+    )?;
+    run_boundaries(p, run, sys);
+    asm::install_membrane(sys, m);
+    rec.ring_area_0 = ring_area(sys).map(|(a, _)| a);
+    at_rest(sys);
+    sys.time = 0.0;
+    sys.step = 0;
+    Ok(())
+}
+
+/// The target packing fraction inside the relaxed membrane. The sample's area is the box's,
+/// changed as the polygon through the membrane's centroids changed since it went on; grains
+/// are scaled, deleted (never membrane grains) or added inside the ring, and the membrane is
+/// made afresh on the same grains as they now lie.
+fn packing_in_membrane(
+    p: &Params,
+    run: &Run,
+    temps: &[Template],
+    sys: &mut System,
+    rec: &mut Record,
+) -> Result<()> {
+    let m = run
+        .membrane
+        .as_ref()
+        .context("the run's scene has no [membrane]")?;
+    let (a, ring) = ring_area(sys).context("the membrane went missing while relaxing")?;
+    let a0 = rec.ring_area_0.context("the checkpoint has no membrane area")?;
+    let box_area = (p.sample.hi[0] - p.sample.lo[0]) * (p.sample.hi[1] - p.sample.lo[1]);
+    let area = box_area * a / a0;
+    rec.relaxed_packing = Some(sys.bodies.total_area() / area);
+    let (mut lo, mut hi) = (Vec2::new(f64::MAX, f64::MAX), Vec2::new(f64::MIN, f64::MIN));
+    for q in &ring {
+        lo = Vec2::new(lo.x.min(q.x), lo.y.min(q.y));
+        hi = Vec2::new(hi.x.max(q.x), hi.y.max(q.y));
+    }
+    let sample = asm::Sample {
+        lo,
+        hi,
+        area,
+        ring: Some(&ring),
+    };
+    let change = asm::adjust_packing(
+        sys,
+        &sample,
+        p.packing.target,
+        p.packing.method,
+        p.packing.max_size_change,
+        &smallest(p, temps, rec, sys),
+        run.density,
+        p.grains.seed,
+    )
+    .with_context(|| format!("[packing] target = {}", p.packing.target))?;
+    rec.packing = Some(change);
+    rec.packing_fraction = change.to;
+    let members: Vec<u32> = (0..sys.bodies.len() as u32)
+        .filter(|&k| sys.bodies.tag[k as usize] == 1)
+        .collect();
+    asm::install_membrane_on(sys, members, m);
+    Ok(())
+}
+
+/// The grain added in interstices (Su: "smaller grains"): the smallest template at
+/// `small_grain` of its size, as fitted to the sample.
+fn smallest(p: &Params, temps: &[Template], rec: &Record, sys: &System) -> lbdem_dem::ClumpShape<Vec2> {
+    temps
+        .iter()
+        .min_by(|a, b| a.d_eq.total_cmp(&b.d_eq))
+        .map(|t| {
+            t.shape
+                .scaled(p.packing.small_grain * (rec.fit.0 * rec.fit.1).sqrt())
+        })
+        .unwrap_or_else(|| lbdem_dem::ClumpShape::disk(0.25 * asm::size_stats(&sys.bodies).d_min))
+}
+
 /// Verlet-list skin: a tenth of the mean grain diameter.
 fn rec_skin(sys: &System) -> f64 {
     0.1 * asm::size_stats(&sys.bodies).d_mean
@@ -424,22 +577,13 @@ fn prepare_relax(
     );
     rec.fit = asm::fit_to_box(sys, lo, hi)?;
     // "Different initial packing fractions were then generated from this sample" (Sect. 2.4).
-    let smallest = temps
-        .iter()
-        .min_by(|a, b| a.d_eq.total_cmp(&b.d_eq))
-        .map(|t| {
-            t.shape
-                .scaled(p.packing.small_grain * (rec.fit.0 * rec.fit.1).sqrt())
-        })
-        .unwrap_or_else(|| lbdem_dem::ClumpShape::disk(0.25 * asm::size_stats(&sys.bodies).d_min));
     let change = asm::adjust_packing(
         sys,
-        lo,
-        hi,
+        &asm::Sample::boxed(lo, hi),
         p.packing.target,
         p.packing.method,
         p.packing.max_size_change,
-        &smallest,
+        &smallest(p, temps, rec, sys),
         run.density * p.compress.mass_scale,
         p.grains.seed,
     )
