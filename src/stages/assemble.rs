@@ -6,7 +6,9 @@
 //! fraction (%PK) by scaling the grains, deleting grains or adding small grains in interstices;
 //! it relaxes inside the sample's walls until every grain is slower than 1e-7 m/s; then the
 //! walls give way to the run's bonded membrane and push-plate, and F_0 (Table 1: the mean
-//! contact force before deformation) is measured under the run's elastic law.
+//! contact force before deformation) is measured under the run's elastic law. In Su's order
+//! (`[relax] inside = "membrane"`) the membrane goes on first, the grains relax inside it under
+//! the run's law, and the %PK is reached in the relaxed membrane.
 //!
 //! Writes `assembly.csv` (grain_id,x,y,r per circle, m) with `assembly.json` (the header a scene
 //! checks: grain set, packing fraction, sizes, F_0), `templates.csv` and `assembly.png`. Long
@@ -163,8 +165,8 @@ pub struct PackingParams {
     pub small_grain: f64,
 }
 
-/// The relaxation after the walls are replaced by the membrane (Su Sect. 2.4), with the
-/// compression's law and step.
+/// The relaxation until every grain is at rest (Su Sect. 2.4): inside the sample's walls with
+/// the compression's law and step, or inside the membrane under the run's (`inside`).
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RelaxParams {

@@ -3,10 +3,9 @@
 //! relaxation inside the sample's walls and the run's membrane and push-plate after it, or, in
 //! Su's order (`[relax] inside = "membrane"`), the membrane and plate on the fitted sample,
 //! relaxation under the run's law, and the target packing fraction inside the membrane; then the
-//! F_0 measure. The
-//! state between chunks of steps is plain data (the DEM system and what was recorded),
-//! checkpointed as JSON; a fresh stepper continues it to the same bits (the stepper's results do
-//! not depend on when its list was built).
+//! F_0 measure. The state between chunks of steps is plain data (the DEM system and what was
+//! recorded), checkpointed as JSON; a fresh stepper continues it to the same bits (the stepper's
+//! results do not depend on when its list was built).
 
 use super::Params;
 use super::templates::{self, Template};

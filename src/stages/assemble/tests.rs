@@ -144,10 +144,16 @@ fn relaxed_inside_the_membrane_the_target_is_reached_in_the_membrane_s_area() {
         r["compressed_packing"].as_f64().unwrap(),
         r["relaxed_packing"].as_f64().unwrap(),
     );
-    assert!(relaxed < compressed - 0.02 && relaxed < 0.84, "{compressed} -> {relaxed}");
+    assert!(
+        relaxed < compressed - 0.02 && relaxed < 0.84,
+        "{compressed} -> {relaxed}"
+    );
     let ch = &r["packing"];
     assert!((ch["from"].as_f64().unwrap() - relaxed).abs() < 1e-12, "{ch}");
-    assert!((s["packing_fraction"].as_f64().unwrap() - 0.84).abs() < 1e-12, "{s}");
+    assert!(
+        (s["packing_fraction"].as_f64().unwrap() - 0.84).abs() < 1e-12,
+        "{s}"
+    );
     assert!(ch["size_scale"].as_f64().unwrap() > 1.0, "{ch}");
     // The membrane is the one that relaxed (the outline's shell of the walls' order would pick
     // another set round a swollen sample): as many grains as it went on with (119 measured).
