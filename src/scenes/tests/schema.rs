@@ -143,7 +143,17 @@ fn a_scene_extends_another_key_by_key_and_loops_are_refused() {
 #[test]
 fn the_su2020_cases_load_their_committed_assemblies() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/su2020");
-    let committed = ["pk81", "pk84", "pk93", "pk95", "sim1", "sim2", "sim3", "float"];
+    let committed = [
+        "pk81",
+        "pk84",
+        "pk93",
+        "pk95",
+        "sim1",
+        "sim2",
+        "sim3",
+        "float",
+        "pk93-membrane",
+    ];
     let (mut built, mut refused) = (0, Vec::new());
     for e in std::fs::read_dir(&dir).unwrap().flatten() {
         let p = e.path();

@@ -486,9 +486,7 @@ fn membrane_on_box(p: &Params, run: &Run, sys: &mut System, rec: &mut Record) ->
     run_boundaries(p, run, sys);
     asm::install_membrane(sys, m);
     rec.ring_area_0 = ring_area(sys).map(|(a, _)| a);
-    at_rest(sys);
-    sys.time = 0.0;
-    sys.step = 0;
+    at_rest_from_zero(sys);
     Ok(())
 }
 
@@ -588,9 +586,7 @@ fn prepare_relax(
     )
     .with_context(|| format!("[packing] target = {}", p.packing.target))?;
     rec.packing = Some(change);
-    at_rest(sys);
-    sys.time = 0.0;
-    sys.step = 0;
+    at_rest_from_zero(sys);
     Ok(())
 }
 
@@ -659,6 +655,13 @@ impl Log {
             self.last = Instant::now();
         }
     }
+}
+
+/// [`at_rest`], with the clock at zero: the start of a phase that steps.
+fn at_rest_from_zero(sys: &mut System) {
+    at_rest(sys);
+    sys.time = 0.0;
+    sys.step = 0;
 }
 
 /// Every grain stopped and the contact history cleared: the state the next phase of the
