@@ -480,9 +480,11 @@ fn membrane_on_box(p: &Params, run: &Run, sys: &mut System, rec: &mut Record) ->
         Vec2::new(p.sample.hi[0], p.sample.hi[1]),
     );
     rec.fit = asm::fit_to_box(sys, lo, hi)?;
-    let m = run.membrane.as_ref().context(
-        "[relax] inside = \"membrane\": the run's scene has no [membrane]; relax inside the walls (inside = \"walls\")",
-    )?;
+    // `run` refused a scene without one before anything ran.
+    let m = run
+        .membrane
+        .as_ref()
+        .context("the run's scene has no [membrane]")?;
     run_boundaries(p, run, sys);
     asm::install_membrane(sys, m);
     rec.ring_area_0 = ring_area(sys).map(|(a, _)| a);

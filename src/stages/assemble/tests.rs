@@ -227,8 +227,12 @@ fn a_digitised_microstructure_is_compressed_where_it_lies() {
 
 #[test]
 fn recipes_that_cannot_work_are_refused_before_anything_runs() {
-    let cases: [(&str, &str); 6] = [
+    let cases: [(&str, &str); 7] = [
         ("[packing]\ntarget = 1.2", "packing fraction in (0, 1)"),
+        (
+            "scene = \"../reduced-float.toml\"\n[relax]\ninside = \"membrane\"",
+            "has no [membrane] to relax in",
+        ),
         ("[grains]\ncount = 0", "count = 0"),
         ("[grains]\ninsert_packing = 0.9", "insert_packing"),
         ("[sample]\nhi = [0.0, 0.0071]", "hi must exceed lo"),
