@@ -355,6 +355,16 @@ impl<T: Real> CoupledModel<T> {
 
 impl<T: Real> Model for CoupledModel<T> {
     fn step(&mut self, _fields: bool) -> Result<()> {
+        // While the plate is held the ladder may stand on its own rung (`held = "smallest"`);
+        // decided from the step count alone, so a resumed run does the same.
+        if let (Some(mc), Some(c)) = (&self.mass_control, &self.cell)
+            && let Some(r) = mc.held_ratio()
+            && c.settling(self.run.lbm_steps())
+        {
+            self.run
+                .set_ratio(r)
+                .map_err(|e| anyhow::anyhow!("[dem.mass_scale_control] held: {e}"))?;
+        }
         let run = &mut self.run;
         self.pool
             .install(|| run.step())
@@ -369,7 +379,7 @@ impl<T: Real> Model for CoupledModel<T> {
             }
         }
         // The shear's inertial number: none while the plate is held (the settling keeps the
-        // scene's scale).
+        // scene's scale, or the bottom rung with `held = "smallest"`).
         if let (Some(mc), Some(c)) = (&self.mass_control, &self.cell)
             && steps.is_multiple_of(mc.every)
             && !c.settling(steps)

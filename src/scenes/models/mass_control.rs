@@ -18,7 +18,7 @@
 //! The decision reads the grains' state alone (the contact forces of the last DEM step), so a
 //! run resumed from a checkpoint takes the same decisions.
 
-use crate::scenes::schema::MassScaleControl;
+use crate::scenes::schema::{HeldScale, MassScaleControl};
 use anyhow::{Result, bail};
 
 /// A heavier scale is taken only while the scaled I would stay under this share of the target.
@@ -34,6 +34,7 @@ pub struct MassControl {
     bottom_ratio: u32,
     target: f64,
     pub every: u64,
+    held: HeldScale,
 }
 
 impl MassControl {
@@ -76,6 +77,7 @@ impl MassControl {
             bottom_ratio,
             target: c.inertial_number,
             every: c.every,
+            held: c.held,
         })
     }
 
@@ -87,6 +89,15 @@ impl MassControl {
     /// The smallest mass scale of the ladder.
     pub fn smallest_scale(&self) -> f64 {
         self.scale(self.bottom_ratio)
+    }
+
+    /// The ratio to stand on while the plate is held, if the scene names one (`held =
+    /// "smallest"`); with `"top"` the ratio the run has (the scene's, before the shear).
+    pub fn held_ratio(&self) -> Option<u32> {
+        match self.held {
+            HeldScale::Top => None,
+            HeldScale::Smallest => Some(self.bottom_ratio),
+        }
     }
 
     /// The smallest ratio on the ladder at which I, measured as `inertial` at `ratio`, stays
@@ -120,6 +131,7 @@ mod tests {
             inertial_number: 0.002,
             smallest,
             every: 20,
+            held: HeldScale::Top,
         };
         // sim1-quick.toml: mass scale 100 at 10 DEM steps per LBM step
         MassControl::new(&c, 100.0, 10)

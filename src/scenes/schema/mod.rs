@@ -21,7 +21,7 @@ pub mod simplify;
 
 pub use coupling::CouplingSection;
 pub use dem::{
-    BondsSection, CompressSection, DemSection, GenerateSection, MassScaleControl, MembraneSection,
+    BondsSection, CompressSection, DemSection, GenerateSection, HeldScale, MassScaleControl, MembraneSection,
     ParticlesSection, TemplateSection, WallSection,
 };
 pub use extruder::{ExtruderSection, NessLaw, SuspensionSection};

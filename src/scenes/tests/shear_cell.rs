@@ -389,6 +389,36 @@ fn an_interrupted_run_whose_mass_scale_follows_the_inertial_number_resumes_to_th
     resumes_to_the_same_bits(following("4.0e-4", 5));
 }
 
+/// `held = "smallest"`: while the plate is held the ladder stands on its bottom rung (the
+/// grains' own masses, ratio 125 here) and follows I from there once the plate moves. The rung
+/// is chosen from the LBM step count alone, so a run resumed inside the settling or after it
+/// takes the same masses, to the bit.
+#[test]
+fn a_mass_scale_held_at_the_bottom_rung_while_the_plate_is_held_resumes_to_the_same_bits() {
+    let t = tempfile::tempdir().unwrap();
+    let probe = t.path().join("probe");
+    let held =
+        |s: String| following("4.0e-4", 5)(s).replace("every = 5\n", "every = 5\nheld = \"smallest\"\n");
+    let text = cell(&probe, |s| held(settled("0.006")(shorter("0.03")(s))));
+    assert!(text.contains("held = \"smallest\""));
+    simulate(&text, &probe, false).unwrap();
+    let out = probe.join("out");
+    let (time, ratio) = (column(&out, "time"), column(&out, "dem_steps_per_lbm_step"));
+    // Outputs after the first step and before the plate moves (t < 6 ms) sit on the bottom
+    // rung; without `held` they keep the scene's 25 (the resume test above).
+    let during: Vec<f64> = time
+        .iter()
+        .zip(&ratio)
+        .filter(|&(&t, _)| t > 0.0 && t < 0.006 - 1e-9)
+        .map(|(_, &r)| r)
+        .collect();
+    assert!(
+        !during.is_empty() && during.iter().all(|&r| r == 125.0),
+        "ratios {ratio:?}"
+    );
+    resumes_to_the_same_bits(held);
+}
+
 /// The reduced cell at mass scale 25 (DEM step 2e-5 s, 25 DEM steps per LBM step: the top of
 /// the ladder), its scale following the inertial number with target `target`, chosen every
 /// `every` LBM steps.
