@@ -174,6 +174,28 @@ pub fn is_v4<S: Simd>() -> bool {
     }
 }
 
+/// Inside an op run by [`dispatch`]: whether this copy (`S`) runs with AVX2 and FMA but not
+/// AVX-512 (the v3 copy, or any copy of a build for such a CPU), so it may take hand-written
+/// AVX2 code. A constant in each copy, false wherever [`is_v4`] is true.
+#[inline(always)]
+pub fn is_v3<S: Simd>() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        !is_v4::<S>() && (NATIVE_V3 || std::any::TypeId::of::<S>() == std::any::TypeId::of::<pulp::x86::V3>())
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// The whole build targets AVX2 and FMA (x86-64-v3) at least.
+pub const NATIVE_V3: bool = cfg!(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+));
+
 /// The whole build targets AVX-512 (x86-64-v4) already.
 pub const NATIVE_V4: bool = cfg!(all(
     target_arch = "x86_64",
@@ -229,6 +251,28 @@ mod tests {
         assert_eq!(dispatch(V4Here), level() == Level::V4);
         assert_eq!(Arch::Scalar.dispatch(V4Here), NATIVE_V4);
         assert_eq!(capped(Level::V3).dispatch(V4Here), NATIVE_V4);
+    }
+
+    struct V3Here;
+    impl WithSimd for V3Here {
+        type Output = bool;
+        #[inline(always)]
+        fn with_simd<S: Simd>(self, _: S) -> bool {
+            is_v3::<S>()
+        }
+    }
+
+    /// `is_v3` is true in exactly the copy that runs with AVX2 and without AVX-512.
+    #[test]
+    fn is_v3_names_the_avx2_copy() {
+        assert_eq!(
+            dispatch(V3Here),
+            level() == Level::V3 || (NATIVE_V3 && !NATIVE_V4)
+        );
+        assert_eq!(Arch::Scalar.dispatch(V3Here), NATIVE_V3 && !NATIVE_V4);
+        if let Some(v3) = pulp::x86::V3::try_new() {
+            assert_eq!(Arch::V3(v3).dispatch(V3Here), !NATIVE_V4);
+        }
     }
 
     #[test]

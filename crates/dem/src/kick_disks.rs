@@ -82,6 +82,10 @@ impl DiskKick {
         if crate::lanes::avx512_in::<S>() {
             return crate::on_avx512::kick::eight(self, e);
         }
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx2_in::<S>() {
+            return crate::on_avx2::kick::eight(self, e);
+        }
         crate::on_arrays::kick::eight(self, e)
     }
 }

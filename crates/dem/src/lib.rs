@@ -19,6 +19,8 @@ mod lanes;
 pub mod neighbor;
 mod on_arrays;
 #[cfg(target_arch = "x86_64")]
+mod on_avx2;
+#[cfg(target_arch = "x86_64")]
 mod on_avx512;
 mod pair_batched;
 pub mod polygon;

@@ -92,6 +92,10 @@ impl BatchedPair {
         if crate::lanes::avx512_in::<S>() {
             return crate::on_avx512::pair::run(self, cst, pairs, hist, out, touch);
         }
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx2_in::<S>() {
+            return crate::on_avx2::pair::run(self, cst, pairs, hist, out, touch);
+        }
         crate::on_arrays::pair::run(self, cst, pairs, hist, out, touch)
     }
 }

@@ -27,19 +27,19 @@ pub(crate) fn run(inp: &KickInput, first: usize, pos: &mut [Vec3], vel: &mut [Ve
         let vr: &mut [Vec3; W] = (&mut vel[q..q + W]).try_into().expect("eight velocities");
         let vr: &mut [[f64; 3]; W] = bytemuck::cast_mut(vr);
         let v = lanes::load3(vr);
-        let v: [F8; 3] = std::array::from_fn(|c| mobile.select(v[c] + f[c] * sv, v[c]));
+        let v = step3(mobile, v, f, sv);
         lanes::store3(vr, v);
         let wr: &mut [Vec3; W] = (&mut omega[q..q + W]).try_into().expect("eight spins");
         let wr: &mut [[f64; 3]; W] = bytemuck::cast_mut(wr);
         let w = lanes::load3(wr);
-        let w: [F8; 3] = std::array::from_fn(|c| mobile.select(w[c] + t[c] * sw, w[c]));
+        let w = step3(mobile, w, t, sw);
         lanes::store3(wr, w);
         if let Some((dt, _)) = inp.drift {
             let xr: &mut [Vec3; W] = (&mut pos[q..q + W]).try_into().expect("eight positions");
             let xr: &mut [[f64; 3]; W] = bytemuck::cast_mut(xr);
             let x = lanes::load3(xr);
             let dt = F8::splat(dt);
-            let x: [F8; 3] = std::array::from_fn(|c| mobile.select(x[c] + v[c] * dt, x[c]));
+            let x = step3(mobile, x, v, dt);
             lanes::store3(xr, x);
         }
     }
@@ -62,6 +62,17 @@ pub(crate) fn run(inp: &KickInput, first: usize, pos: &mut [Vec3], vel: &mut [Ve
             }
         }
     }
+}
+
+/// `a + b s` where `mobile`, else `a`, per component (a function, not `from_fn` with a
+/// closure: a closure is compiled without the lane copy's target features).
+#[inline(always)]
+fn step3(mobile: lanes::M8, a: [F8; 3], b: [F8; 3], s: F8) -> [F8; 3] {
+    [
+        mobile.select(a[0] + b[0] * s, a[0]),
+        mobile.select(a[1] + b[1] * s, a[1]),
+        mobile.select(a[2] + b[2] * s, a[2]),
+    ]
 }
 
 /// Lanes `a[g..g + 8]` (a function, not a closure: a closure is compiled without the target

@@ -40,7 +40,7 @@ pub(crate) fn run(
                 F8::from_array(std::array::from_fn(|k| hist[lane(k)].z)),
             ];
             let r = eight(kp, &si, &sj, h0);
-            let [hx, hy, hz] = r.hist.map(F8::to_array);
+            let [hx, hy, hz] = arrays3(r.hist);
             for k in 0..m {
                 hist[q + k] = Vec3::new(hx[k], hy[k], hz[k]);
             }
@@ -53,9 +53,7 @@ pub(crate) fn run(
 /// The first `out.len()` lanes of `r` as pair records.
 #[inline(always)]
 fn store_records(out: &mut [PairRecord], r: &LaneOut) {
-    let f = r.f.map(F8::to_array);
-    let ti = r.ti.map(F8::to_array);
-    let tj = r.tj.map(F8::to_array);
+    let (f, ti, tj) = (arrays3(r.f), arrays3(r.ti), arrays3(r.tj));
     for (k, o) in out.iter_mut().enumerate() {
         *o = PairRecord {
             f: [f[0][k], f[1][k], f[2][k]],
@@ -63,6 +61,13 @@ fn store_records(out: &mut [PairRecord], r: &LaneOut) {
             tj: [tj[0][k], tj[1][k], tj[2][k]],
         };
     }
+}
+
+/// The three lane vectors as arrays (a function, not `map` with a closure: a closure is
+/// compiled without the lane copy's target features).
+#[inline(always)]
+fn arrays3(v: [F8; 3]) -> [[f64; W]; 3] {
+    [v[0].to_array(), v[1].to_array(), v[2].to_array()]
 }
 
 struct LaneOut {

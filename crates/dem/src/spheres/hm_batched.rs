@@ -94,6 +94,10 @@ impl HmPair {
         if crate::lanes::avx512_in::<S>() {
             return crate::on_avx512::sphere::run(self, lines, pairs, hist, out);
         }
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx2_in::<S>() {
+            return crate::on_avx2::sphere::run(self, lines, pairs, hist, out);
+        }
         crate::on_arrays::sphere::run(self, lines, pairs, hist, out)
     }
 }

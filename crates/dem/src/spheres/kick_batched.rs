@@ -35,6 +35,10 @@ impl WithSimd for KickChunk<'_> {
         if crate::lanes::avx512_in::<S>() {
             return crate::on_avx512::sphere_kick::run(self.inp, self.first, self.pos, self.vel, self.omega);
         }
+        #[cfg(target_arch = "x86_64")]
+        if crate::lanes::avx2_in::<S>() {
+            return crate::on_avx2::sphere_kick::run(self.inp, self.first, self.pos, self.vel, self.omega);
+        }
         crate::on_arrays::sphere_kick::run(self.inp, self.first, self.pos, self.vel, self.omega)
     }
 }
