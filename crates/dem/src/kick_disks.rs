@@ -75,7 +75,7 @@ impl DiskKick {
     }
 
     /// [`DiskKick::eight`] inside an op dispatched at level `S`: the AVX-512 lanes in the v4
-    /// copy, the array lanes in the others.
+    /// copy, the AVX2 lanes in the v3 copy, the array lanes in the baseline copy.
     #[inline(always)]
     pub(crate) fn eight_in<S: Simd>(&self, e: Eight<'_>) -> Option<f64> {
         #[cfg(target_arch = "x86_64")]

@@ -78,7 +78,7 @@ impl BatchedPair {
     /// Evaluate `pairs` (with their `hist`), writing each pair's force on i and torques on i
     /// and j to `out` and 1/0 (touching or not) to `touch`. Runs inside an op of
     /// `lbdem_core::simd::dispatch` at level `S` (the stepper's passes): the AVX-512 lanes in
-    /// the v4 copy, the array lanes in the others.
+    /// the v4 copy, the AVX2 lanes in the v3 copy, the array lanes in the baseline copy.
     #[inline(always)]
     pub(crate) fn run_in<S: Simd>(
         &self,

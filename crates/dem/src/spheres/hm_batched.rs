@@ -80,8 +80,8 @@ impl HmPair {
     }
 
     /// Evaluate `pairs` with their springs `hist` into `out`. Runs inside an op of
-    /// `lbdem_core::simd::dispatch` at level `S`: the AVX-512 lanes in the v4 copy, the array
-    /// lanes in the others.
+    /// `lbdem_core::simd::dispatch` at level `S`: the AVX-512 lanes in the v4 copy, the AVX2
+    /// lanes in the v3 copy, the array lanes in the baseline copy.
     #[inline(always)]
     pub(crate) fn run_in<S: Simd>(
         &self,

@@ -1,5 +1,5 @@
 //! The sphere engine's half kick and drift eight spheres at a time (`crate::sphere_kick_lanes`,
-//! AVX-512 registers or arrays, chosen per chunk by `lbdem_core::simd::dispatch`), with the
+//! AVX-512 registers, AVX2 registers or arrays, chosen per chunk by `lbdem_core::simd::dispatch`), with the
 //! scalar kick's bits; `spheres::stepper::kick` hands it chunks of spheres.
 
 use super::domain::Domain3;

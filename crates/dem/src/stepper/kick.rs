@@ -13,7 +13,8 @@ use rayon::prelude::*;
 impl Stepper {
     /// [`Stepper::kick_drift`] and [`Stepper::update_circles`] in one pass when every body is a
     /// single centred circle (circle k = body k). Each chunk is one op of
-    /// `lbdem_core::simd::dispatch`: the AVX-512 lanes at v4, the array lanes at the other levels.
+    /// `lbdem_core::simd::dispatch`: the AVX-512 lanes at v4, the AVX2 lanes at v3, the array lanes
+    /// at the baseline.
     pub(super) fn kick_drift_disks(&mut self, sys: &mut System, h: f64, dt: f64) -> f64 {
         let dom = sys.domain;
         let b = &mut sys.bodies;
