@@ -93,7 +93,7 @@ pub fn observers(s: &Scene, total: u64) -> Result<(Vec<Box<dyn Observer>>, Trigg
     let out = &s.output;
     let series = trigger(s, "series", &out.series, total)?;
     let mut obs: Vec<Box<dyn Observer>> = vec![
-        Box::new(Series::new(series.clone())),
+        Box::new(Series::new(series.clone()).warn_above_mach(s.lattice.as_ref().map(|l| l.mach_warn))),
         Box::new(Snapshots::new(trigger(s, "snapshots", &out.snapshots, total)?)),
     ];
     let r = &s.run;
@@ -179,7 +179,10 @@ pub fn run(l: &Loaded, dir: &Path, key: &str, resume: bool) -> Result<SceneResul
         if let Some(why) = ending.stopped.as_ref().filter(|_| !crate::contract::quiet()) {
             eprintln!("{}: {why}; stopping", l.name);
         }
-        let warnings = m.warnings();
+        let mut warnings = m.warnings();
+        for o in &obs {
+            warnings.extend(o.warnings(m.as_ref()));
+        }
         if !crate::contract::quiet() {
             for w in &warnings {
                 eprintln!("{}: warning: {w}", l.name);

@@ -203,6 +203,11 @@ pub trait Observer {
     fn restore(&mut self, _v: serde_json::Value) -> Result<()> {
         Ok(())
     }
+    /// After the run: accuracy failures this observer saw in what it recorded, each naming the
+    /// fix (printed after the run and kept in its summary beside [`Model::warnings`]).
+    fn warnings(&self, _m: &dyn Model) -> Vec<String> {
+        Vec::new()
+    }
     /// After the run: the files it wrote (relative to the run's directory) and an entry for
     /// the run's summary.
     fn report(&self, _m: &dyn Model) -> (Vec<PathBuf>, Option<(&'static str, serde_json::Value)>) {

@@ -8,6 +8,9 @@ use serde::{Deserialize, Serialize};
 pub struct Series {
     trigger: Trigger,
     state: State,
+    /// `[lattice] mach_warn`: the liquid's largest Mach number (`max_mach`) the scene's checks
+    /// assumed it would stay under; a run that went above it is named after it ends.
+    mach_warn: Option<f64>,
 }
 
 #[derive(Default, Serialize, Deserialize)]
@@ -24,7 +27,14 @@ impl Series {
         Self {
             trigger,
             state: State::default(),
+            mach_warn: None,
         }
+    }
+
+    /// Name the run after it ends if its `max_mach` column went above `limit`.
+    pub fn warn_above_mach(mut self, limit: Option<f64>) -> Self {
+        self.mach_warn = limit;
+        self
     }
 }
 
@@ -87,6 +97,71 @@ impl Observer for Series {
     }
     fn report(&self, m: &dyn Model) -> (Vec<std::path::PathBuf>, Option<(&'static str, serde_json::Value)>) {
         (vec![FILE.into()], Some(("last", self.last(m))))
+    }
+    fn warnings(&self, m: &dyn Model) -> Vec<String> {
+        let (Some(limit), Some(k)) = (
+            self.mach_warn,
+            m.series_columns().iter().position(|c| c == "max_mach"),
+        ) else {
+            return Vec::new();
+        };
+        // column k of the model's sample is column k + 1 of a row (time first)
+        let mach: Vec<f64> = self.state.rows.iter().map(|r| r[k + 1]).collect();
+        let times: Vec<f64> = self.state.rows.iter().map(|r| r[0]).collect();
+        mach_warning(limit, &self.state.steps, &times, &mach)
+            .into_iter()
+            .collect()
+    }
+}
+
+/// The warning for a run whose liquid went above the Mach number `limit` at some output: when it
+/// first did and how far it went. The checks before a run bound the Mach number the scene
+/// expects (`u_max`); a run can still leave it, e.g. a membrane ringing under the liquid after
+/// seconds of quiet (docs/stability.md, "Damped membrane bonds"), and its series from then on is
+/// not accurate.
+fn mach_warning(limit: f64, steps: &[u64], times: &[f64], mach: &[f64]) -> Option<String> {
+    let first = mach.iter().position(|&m| m > limit)?;
+    let (peak_at, peak) =
+        mach.iter()
+            .enumerate()
+            .filter(|(_, m)| !m.is_nan())
+            .fold(
+                (first, mach[first]),
+                |best, (i, &m)| if m > best.1 { (i, m) } else { best },
+            );
+    Some(format!(
+        "the liquid's largest Mach number went above [lattice] mach_warn = {limit} at step {} (t = {:.4e} s) \
+         and reached {peak:.3} at step {} (t = {:.4e} s): the results from step {} on are not accurate. \
+         The series' max_mach column shows how it grew: from a quiet start over many outputs, a \
+         membrane or wall ringing under the liquid is the likely cause (raise [bonds] damping, \
+         the membrane's mass or the number of DEM steps per LBM step; docs/stability.md, \
+         \"Damped membrane bonds\"); from the first outputs, the scene's u_max is too low for the flow",
+        steps[first], times[first], steps[peak_at], times[peak_at], steps[first]
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mach_warning;
+
+    #[test]
+    fn a_run_above_its_mach_warning_is_named_with_when_and_how_far() {
+        let steps = [0, 155, 310, 465, 620];
+        let times = [0.0, 0.1, 0.2, 0.3, 0.4];
+        // quiet, then growing past 0.1 and back down: the first crossing and the peak
+        let mach = [0.0009, 0.0022, 0.14, 0.6, 0.3];
+        let w = mach_warning(0.1, &steps, &times, &mach).unwrap();
+        assert!(w.contains("at step 310 (t = 2.0000e-1 s)"), "{w}");
+        assert!(w.contains("reached 0.600 at step 465"), "{w}");
+        assert!(w.contains("[bonds] damping"), "{w}");
+        // never above: nothing; exactly at the limit is not above it
+        assert_eq!(
+            mach_warning(0.1, &steps, &times, &[0.0009, 0.1, 0.05, 0.0, 0.01]),
+            None
+        );
+        // a NaN output (a series with a missing value) neither triggers nor becomes the peak
+        let w = mach_warning(0.1, &steps, &times, &[f64::NAN, 0.2, f64::NAN, 0.15, 0.0]).unwrap();
+        assert!(w.contains("reached 0.200 at step 155"), "{w}");
     }
 }
 
