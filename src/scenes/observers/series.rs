@@ -140,6 +140,22 @@ fn mach_warning(limit: f64, steps: &[u64], times: &[f64], mach: &[f64]) -> Optio
     ))
 }
 
+impl Series {
+    /// The last row as (column, value), for the summary.
+    fn last(&self, m: &dyn Model) -> serde_json::Value {
+        let mut out = serde_json::Map::new();
+        if let (Some(step), Some(row)) = (self.state.steps.last(), self.state.rows.last()) {
+            out.insert("step".into(), (*step).into());
+            let mut names = vec!["time".to_string()];
+            names.extend(m.series_columns());
+            for (n, v) in names.into_iter().zip(row) {
+                out.insert(n, serde_json::json!(v));
+            }
+        }
+        serde_json::Value::Object(out)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::mach_warning;
@@ -162,21 +178,5 @@ mod tests {
         // a NaN output (a series with a missing value) neither triggers nor becomes the peak
         let w = mach_warning(0.1, &steps, &times, &[f64::NAN, 0.2, f64::NAN, 0.15, 0.0]).unwrap();
         assert!(w.contains("reached 0.200 at step 155"), "{w}");
-    }
-}
-
-impl Series {
-    /// The last row as (column, value), for the summary.
-    fn last(&self, m: &dyn Model) -> serde_json::Value {
-        let mut out = serde_json::Map::new();
-        if let (Some(step), Some(row)) = (self.state.steps.last(), self.state.rows.last()) {
-            out.insert("step".into(), (*step).into());
-            let mut names = vec!["time".to_string()];
-            names.extend(m.series_columns());
-            for (n, v) in names.into_iter().zip(row) {
-                out.insert(n, serde_json::json!(v));
-            }
-        }
-        serde_json::Value::Object(out)
     }
 }

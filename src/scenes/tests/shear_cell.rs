@@ -514,7 +514,11 @@ fn a_settling_to_rest_lets_the_plate_go_when_every_grain_is_slower_than_the_crit
     assert!(u.last().unwrap() > &0.0);
     // [run] time counts after the longest hold: let go early, the run goes on to its end.
     assert_eq!(rec.output.summary["steps"], 220, "{}", rec.output.summary);
-    assert_eq!(rec.output.summary["warnings"], serde_json::json!([]));
+    // Let go in time: no settling warning. (The kicked cell's liquid spikes to Mach 0.216 at its
+    // last step, 220, and is named for it by the series' Mach check: measured in a run 20 steps
+    // longer, the spike is an event at that step, falling back to 0.038 within four steps.)
+    let w = rec.output.summary["warnings"].to_string();
+    assert!(!w.contains("settle_until_rest"), "{w}");
 
     // Never at rest: let go at max_time, and said so.
     let (rec, out) = run(&t.path().join("never"), "1.0e-9");
