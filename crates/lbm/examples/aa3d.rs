@@ -63,6 +63,7 @@ fn main() {
     pool.install(|| match prec {
         "f64" => run::<f64, f64>(n, reps, steps),
         "f32" => run::<f32, f32>(n, reps, steps),
-        _ => run::<f32, ShiftedF16>(n, reps, steps),
+        "f16s" => run::<f32, ShiftedF16>(n, reps, steps),
+        other => eprintln!("precision {other:?}: expected f64, f32 or f16s"),
     });
 }

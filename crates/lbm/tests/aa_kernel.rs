@@ -111,12 +111,13 @@ fn aa_identical_for_one_and_two_threads() {
     }
 }
 
-/// A periodic row is collided in whole blocks from x = 0, its two edge blocks with one slot per
-/// lane so that their lanes can wrap around (`kernel_aa::periodic_row`). Shifting the initial field
-/// by k nodes along x must shift the result by k nodes exactly, in every storage: a lane given a
-/// wrong slot at the edge would compute a node differently from the same node lying inside a block
-/// of the shifted run. Widths with and without a remainder after the last whole block, and one
-/// narrower than a block.
+/// The odd step collides a periodic row's span [1, nx − 1) in blocks and narrower tails and its
+/// two edge nodes one at a time with wrapped slots (`kernel_aa::odd_row`). Shifting the initial
+/// field by k nodes along x must shift the result by k nodes exactly, in every storage: a node
+/// given a wrong slot at the edge, or a tail lane a wrong conversion, would compute differently
+/// from the same node lying inside a block of the shifted run. Widths with and without a
+/// remainder after the last whole block, and one narrower than a block. (A lane swap in an edge
+/// block of a variant that collided the edges in the vector block failed it with 2142 values.)
 #[test]
 fn periodic_rows_shift_exactly_in_every_storage() {
     use lbdem_lbm::{Domain, Fluid, ShiftedF16, ShiftedF32, Storage};

@@ -116,9 +116,9 @@ impl Observer for Series {
 
 /// The warning for a run whose liquid went above the Mach number `limit` at some output: when it
 /// first did and how far it went. The checks before a run bound the Mach number the scene
-/// expects (`u_max`); a run can still leave it, e.g. a membrane ringing under the liquid after
-/// seconds of quiet (docs/stability.md, "Damped membrane bonds"), and its series from then on is
-/// not accurate.
+/// expects (`u_max`); a run can still leave it, e.g. a light membrane ringing with the liquid
+/// after seconds of quiet (docs/stability.md, "Damped membrane bonds"), and its series from then
+/// on is not accurate.
 fn mach_warning(limit: f64, steps: &[u64], times: &[f64], mach: &[f64]) -> Option<String> {
     let first = mach.iter().position(|&m| m > limit)?;
     let (peak_at, peak) =
@@ -132,10 +132,11 @@ fn mach_warning(limit: f64, steps: &[u64], times: &[f64], mach: &[f64]) -> Optio
     Some(format!(
         "the liquid's largest Mach number went above [lattice] mach_warn = {limit} at step {} (t = {:.4e} s) \
          and reached {peak:.3} at step {} (t = {:.4e} s): the results from step {} on are not accurate. \
-         The series' max_mach column shows how it grew: from a quiet start over many outputs, a \
-         membrane or wall ringing under the liquid is the likely cause (raise [bonds] damping, \
-         the membrane's mass or the number of DEM steps per LBM step; docs/stability.md, \
-         \"Damped membrane bonds\"); from the first outputs, the scene's u_max is too low for the flow",
+         The series' max_mach column shows how it grew: from a quiet start over many outputs, \
+         grains lighter than the liquid ringing with it are the likely cause (a Su membrane at \
+         Table 1's mass did; three times heavier, [membrane] mass_scale = 3, it did not; more \
+         [bonds] damping did not help: docs/stability.md, \"Damped membrane bonds\"); from the \
+         first outputs, the scene's u_max is too low for the flow",
         steps[first], times[first], steps[peak_at], times[peak_at], steps[first]
     ))
 }
@@ -169,7 +170,7 @@ mod tests {
         let w = mach_warning(0.1, &steps, &times, &mach).unwrap();
         assert!(w.contains("at step 310 (t = 2.0000e-1 s)"), "{w}");
         assert!(w.contains("reached 0.600 at step 465"), "{w}");
-        assert!(w.contains("[bonds] damping"), "{w}");
+        assert!(w.contains("[membrane] mass_scale"), "{w}");
         // never above: nothing; exactly at the limit is not above it
         assert_eq!(
             mach_warning(0.1, &steps, &times, &[0.0009, 0.1, 0.05, 0.0, 0.01]),
