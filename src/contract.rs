@@ -86,6 +86,21 @@ pub struct Interrupted {
     pub step: u64,
 }
 
+/// A run that failed after it started (a blow-up the engine diagnosed): nothing is published,
+/// but its working directory is kept with what it recorded until then (the series, the last
+/// checkpoint), because how the failure grew is what a user needs to see: a Simulation I run that
+/// blew up after 27 minutes left nothing to show where it started (docs/stability.md, "Damped
+/// membrane bonds"). Returned inside an `anyhow::Error`, as context over the failure.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "the run failed (below); what it recorded until then is kept in {} (series.csv; not published, and \
+     the next run there without --resume removes it)",
+    dir.display()
+)]
+pub struct FailedRun {
+    pub dir: PathBuf,
+}
+
 /// What a stage gets besides its parameters.
 #[derive(Clone)]
 pub struct StageContext {

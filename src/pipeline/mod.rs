@@ -9,7 +9,9 @@ pub mod lanes;
 pub mod provenance;
 pub mod schema;
 
-use crate::contract::{CHECKPOINT, Interrupted, MANIFEST, StageContext, StageRecord, code_version};
+use crate::contract::{
+    CHECKPOINT, FailedRun, Interrupted, MANIFEST, StageContext, StageRecord, code_version,
+};
 use crate::registry::{self, Prepared, StageKind};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -30,9 +32,10 @@ fn writes_in_place(kind: &str) -> bool {
 /// Hash the inputs, run the stage and write its manifest atomically.
 ///
 /// Outputs go to a working directory inside the output directory and are moved into place
-/// only when the stage succeeds: a failed stage leaves nothing behind, and a directory the run
-/// created is removed again. Resumable stages work in [`PARTIAL`], which survives a killed
-/// process or an [`Interrupted`] stop; with `ctx.resume` the stage continues from it.
+/// only when the stage succeeds: a refused or failed stage publishes nothing, and a directory the
+/// run created is removed again. Resumable stages work in [`PARTIAL`], which survives a killed
+/// process or an [`Interrupted`] stop (with `ctx.resume` the stage continues from it), and a run
+/// that failed after it started ([`FailedRun`]: kept to be looked at, never published).
 pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
     let kind = prepared.kind.clone();
     let inputs = cache::hash_inputs(&prepared.inputs)?;
@@ -125,19 +128,20 @@ pub fn execute(prepared: Prepared, ctx: &StageContext) -> Result<StageRecord> {
             kind
         ))
     });
-    let interrupted = result
-        .as_ref()
-        .err()
-        .is_some_and(|e| e.downcast_ref::<Interrupted>().is_some());
+    // An interrupted run keeps its working directory to be resumed, a run that failed after it
+    // started keeps it to be looked at; neither publishes anything.
+    let kept = result.as_ref().err().is_some_and(|e| {
+        e.downcast_ref::<Interrupted>().is_some() || e.downcast_ref::<FailedRun>().is_some()
+    });
     if staging != ctx.out_dir {
         if result.is_ok() {
             publish(&staging, &ctx.out_dir)?;
         }
-        if !interrupted {
+        if !kept {
             let _ = std::fs::remove_dir_all(&staging);
         }
     }
-    if result.is_err() && created && !interrupted {
+    if result.is_err() && created && !kept {
         let _ = std::fs::remove_dir(&ctx.out_dir); // only succeeds when empty
     }
     result

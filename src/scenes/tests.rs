@@ -1,7 +1,7 @@
 //! Scene-level tests, through the runner as `lbdem simulate` runs them: the physics of each
 //! kind of scene points the right way or matches its analytic answer, bad set-ups are refused
-//! before anything is written, a failed run leaves nothing behind, and an interrupted run
-//! resumes to the same bits.
+//! before anything is written, a failed run publishes nothing (its series kept to look at), and
+//! an interrupted run resumes to the same bits.
 
 use crate::contract::{StageContext, StageRecord};
 use std::path::{Path, PathBuf};

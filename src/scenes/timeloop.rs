@@ -193,6 +193,11 @@ pub trait Observer {
         false
     }
     fn observe(&mut self, m: &mut dyn Model, cx: &LoopCtx) -> Result<Flow>;
+    /// Whether [`Observer::finish`] also runs when the run fails after it started, to keep what
+    /// was recorded until then (the series: [`crate::contract::FailedRun`]).
+    fn at_failure(&self) -> bool {
+        false
+    }
     /// After the loop (also after a stop): write what is left.
     fn finish(&mut self, _m: &mut dyn Model, _cx: &LoopCtx) -> Result<()> {
         Ok(())
@@ -302,7 +307,9 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
             })
             .collect();
         let fields = condition_fields || observers.iter().zip(&fire).any(|(o, f)| *f && o.needs_fields());
-        model.step(fields)?;
+        if let Err(e) = model.step(fields) {
+            return Err(failed(model, observers, dir, key, total, e));
+        }
         step = model.steps_done();
         let cx = LoopCtx {
             dir,
@@ -379,6 +386,36 @@ pub fn run(model: &mut dyn Model, observers: &mut [Box<dyn Observer>], cfg: &Loo
         wall_s: t0.elapsed().as_secs_f64(),
         resumed_from,
     })
+}
+
+/// The error of a run that failed after it started, with what its observers recorded until then
+/// written to `dir` (kept by the runner: [`crate::contract::FailedRun`]); the failure alone if
+/// nothing could be written.
+fn failed(
+    model: &mut dyn Model,
+    observers: &mut [Box<dyn Observer>],
+    dir: &Path,
+    key: &str,
+    total: u64,
+    e: anyhow::Error,
+) -> anyhow::Error {
+    let cx = LoopCtx {
+        dir,
+        key,
+        total_steps: total,
+        last: true,
+    };
+    let mut wrote = false;
+    for o in observers.iter_mut().filter(|o| o.at_failure()) {
+        wrote |= o.finish(model, &cx).is_ok();
+    }
+    if wrote {
+        e.context(crate::contract::FailedRun {
+            dir: dir.to_path_buf(),
+        })
+    } else {
+        e
+    }
 }
 
 /// Write the checkpoint (atomically).

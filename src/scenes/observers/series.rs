@@ -61,6 +61,9 @@ impl Observer for Series {
         }
         Ok(Flow::Continue)
     }
+    fn at_failure(&self) -> bool {
+        true
+    }
     fn finish(&mut self, m: &mut dyn Model, cx: &LoopCtx) -> Result<()> {
         let mut names = vec!["time".to_string()];
         names.extend(m.series_columns());

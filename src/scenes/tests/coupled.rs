@@ -77,20 +77,49 @@ fn non_integer_time_step_ratio_is_refused_before_writing() {
 
 /// Where a method fails: at tau = 0.567 moving bounce-back with refilling blows up within 60
 /// LBM steps on the example while PSM runs it; the failure names the step, the node and the
-/// cause, and leaves none of the run's files behind.
+/// cause, publishes none of the run's files, and keeps what the run recorded until then in its
+/// working directory, where the error says (`contract::FailedRun`).
 #[test]
-fn bounce_back_failure_is_diagnosed_and_leaves_nothing() {
+fn bounce_back_failure_is_diagnosed_and_keeps_only_its_series() {
     let dir = tempfile::tempdir().unwrap();
-    let v = example(|t| short(t).replace("method = \"psm\"", "method = \"bounce-back\""));
+    let v = example(|t| {
+        short(t)
+            .replace("method = \"psm\"", "method = \"bounce-back\"")
+            .replace("series = { every = 50 }", "series = { every = 5 }")
+    });
     let e = format!("{:#}", simulate(&v, dir.path(), false).unwrap_err());
     assert!(
         e.contains("unstable at step") && e.contains("node") && e.contains("Mach"),
         "{e}"
     );
+    let partial = dir.path().join("out").join(crate::pipeline::PARTIAL);
+    assert!(e.contains(&partial.display().to_string()), "{e}");
     let left = walk(dir.path());
     assert!(
-        left.iter().all(|p| p.starts_with(dir.path().join("scene"))),
-        "left behind: {left:?}"
+        left.iter()
+            .all(|p| p.starts_with(dir.path().join("scene")) || p.starts_with(&partial)),
+        "published: {left:?}"
+    );
+    // The series ends at the last output before the failure, which it names.
+    let series = partial.join("series.csv");
+    let steps = crate::report::table::f64_column(
+        &crate::report::table::read_table(&series).unwrap(),
+        "step",
+        &series,
+    )
+    .unwrap();
+    let failed_at: f64 = e
+        .split("unstable at step ")
+        .nth(1)
+        .unwrap()
+        .split(|c: char| !c.is_ascii_digit())
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        !steps.is_empty() && *steps.last().unwrap() < failed_at,
+        "series steps {steps:?}, failed at {failed_at}"
     );
     assert!(simulate(&example(short), &dir.path().join("psm"), false).is_ok());
 }

@@ -83,10 +83,18 @@ fn unstable_run_stops_and_writes_no_report() {
         e.contains("unstable at step") && e.contains("likely cause"),
         "{e}"
     );
+    // Nothing published: the run's working directory alone is kept, with its series
+    // (`contract::FailedRun`), and the next run there discards it.
+    let out = dir.path().join("out");
+    let partial = out.join(crate::pipeline::PARTIAL);
+    let left = walk(&out);
     assert!(
-        !dir.path().join("out").exists(),
-        "left behind: {:?}",
-        walk(&dir.path().join("out"))
+        left.iter().all(|p| p.starts_with(&partial)) && left.contains(&partial.join("series.csv")),
+        "left: {left:?}"
+    );
+    assert!(
+        e.contains("is kept in") && e.contains(&partial.display().to_string()),
+        "{e}"
     );
 }
 
