@@ -59,6 +59,8 @@ pub struct CoupledModel<T: Real> {
     /// ρ_0 of Su Eq. 19 (lattice units): 1 at the start, the liquid nodes' mean density when
     /// the plate starts after `[shear_cell] settle`.
     rho0: f64,
+    /// What the checks before the start warned of, repeated in the summary's `warnings`.
+    start_warnings: Vec<String>,
 }
 
 /// A node is liquid, for Δp (Su Eq. 19, Fig. 10's "interstitial liquid") and the cracking
@@ -202,11 +204,11 @@ impl<T: Real> CoupledModel<T> {
                 Some(MassControl::new(c, dem.mass_scale, run.units.ratio)?)
             }
         };
+        // The lightest grains the run may reach: the bottom of the ladder.
+        let lightest = mass_control
+            .as_ref()
+            .map_or(dem.mass_scale, MassControl::smallest_scale);
         if cs.method == Method::Psm {
-            // The lightest grains the run may reach: the bottom of the ladder.
-            let lightest = mass_control
-                .as_ref()
-                .map_or(dem.mass_scale, MassControl::smallest_scale);
             light_grains(&run, s, lightest)?;
         }
         if cs.interior_liquid_correction {
@@ -242,11 +244,13 @@ impl<T: Real> CoupledModel<T> {
         shear_cell::clear_plate_noting(s, &mut run.sys)?;
         let dt = run.units.dt();
         let cell = Tracked::start(s, &mut run.sys, dt)?;
+        let mut start_warnings = Vec::new();
         if let (Some(c), Some(sc)) = (&cell, &s.shear_cell)
             && sc.confine_liquid
         {
             if sc.membrane_boundary == MembraneBoundary::Moving {
                 damped_membrane(s)?;
+                start_warnings.extend(light_membrane(&run, s, lightest));
             }
             run = run
                 .with_confinement(vec![c.cell.plate], sc.membrane_boundary)
@@ -265,7 +269,13 @@ impl<T: Real> CoupledModel<T> {
             mass_control,
             liquid_mass0: 0.0,
             rho0: 1.0,
+            start_warnings,
         };
+        if !crate::contract::quiet() {
+            for w in &m.start_warnings {
+                eprintln!("coupled: warning: {w}");
+            }
+        }
         m.liquid_mass0 = m.liquid_mass();
         Ok(m)
     }
@@ -542,9 +552,10 @@ impl<T: Real> Model for CoupledModel<T> {
     }
     fn warnings(&self) -> Vec<String> {
         let Some(c) = &self.cell else {
-            return Vec::new();
+            return self.start_warnings.clone();
         };
-        let mut w = c.warnings(&self.run.sys, self.dt());
+        let mut w = self.start_warnings.clone();
+        w.extend(c.warnings(&self.run.sys, self.dt()));
         // The liquid ends at the lattice's faces: a membrane pushed beyond them confines its
         // liquid there, not along itself (the 95 %PK sample settling to rest reached x = 8.6 mm
         // of a lattice ending at 8.5 mm).
@@ -636,6 +647,53 @@ fn damped_membrane(s: &Scene) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Lightest membrane grain, against the liquid's density, below which a moving membrane boundary
+/// is warned before the run starts. Simulation I at Table 1's masses (bonds damped at ζ = 0.2)
+/// with the membrane grains 0.90, 1.08, 1.35, 1.80 and 2.7 times the liquid's density
+/// (`sweeps/su2020-membrane-mass.toml`): quiet to u_y = 2 d̄ in every run; then the lighter three
+/// rang with the liquid, from 2.08, 2.23 and about 2.9 d̄ (1.35 blowing up at LBM step 16 910),
+/// while at 1.80 the disturbance near 2.9 d̄ died out (Mach 0.0017, back to 0.0009; quiet to
+/// 4.33 d̄) and at 2.7 the run stayed quiet to 6.26 d̄ (docs/stability.md, "Damped membrane
+/// bonds"). The edge lies between 1.35 and 1.80; the limit is the lowest ratio that held. Short
+/// runs at 0.90 (the reduced cell's 0.4 s) were accurate, so this warns, as the density map's
+/// inaccurate band does, rather than refuses.
+pub const MOVING_MEMBRANE_DENSITY_RATIO_WARN: f64 = 1.8;
+
+/// The warning of [`MOVING_MEMBRANE_DENSITY_RATIO_WARN`], if the lightest membrane grain (at the
+/// mass scale `scale`, the bottom of a mass-scale ladder if there is one) is under it.
+fn light_membrane<T: Real>(run: &Coupled<T>, s: &Scene, scale: f64) -> Option<String> {
+    let at = s.dem.as_ref().map_or(1.0, |d| d.mass_scale);
+    let b = &run.sys.bodies;
+    let membrane = run.sys.membrane.as_ref()?;
+    let lightest = membrane
+        .bodies
+        .iter()
+        .map(|&k| b.density[k as usize] / run.depth * scale / at)
+        .fold(f64::INFINITY, f64::min);
+    let ratio = lightest / run.liquid_density();
+    if ratio >= MOVING_MEMBRANE_DENSITY_RATIO_WARN {
+        return None;
+    }
+    let ladder = s.dem.as_ref().and_then(|d| d.mass_scale_control.as_ref());
+    let at_key = match ladder {
+        Some(c) if scale != at => format!(
+            "[dem.mass_scale_control] smallest = {}, if the run goes down to it,",
+            c.smallest
+        ),
+        _ => format!("[dem] mass_scale = {at}"),
+    };
+    let factor = s.membrane.as_ref().map_or(1.0, |m| m.mass_scale);
+    let need = factor * MOVING_MEMBRANE_DENSITY_RATIO_WARN / ratio;
+    Some(format!(
+        "[shear_cell] membrane_boundary = \"moving\": {at_key} makes the membrane grains {ratio:.3} times the \
+         liquid's density; Simulation I at Table 1's masses with membranes 0.90-1.35 times it ran quietly to \
+         u_y = 2 d, then rang with the liquid (at 1.35 it blew up near 2.9 d), at 1.80 and 2.7 it did not \
+         (docs/stability.md, \"Damped membrane bonds\"). A run past 2 d needs [membrane] mass_scale = \
+         {need:.2} or more (the membrane is confinement, not sample: at 2 times Table 1's mass it moved \
+         eps_vol^DEM by 0.0005-0.0008)"
+    ))
 }
 
 /// Refuse a PSM scene whose lightest wet grain is under [`PSM_DENSITY_RATIO_MIN`] times the

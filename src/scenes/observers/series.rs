@@ -137,7 +137,7 @@ fn mach_warning(limit: f64, steps: &[u64], times: &[f64], mach: &[f64]) -> Optio
          and reached {peak:.3} at step {} (t = {:.4e} s): the results from step {} on are not accurate. \
          The series' max_mach column shows how it grew: from a quiet start over many outputs, \
          grains lighter than the liquid ringing with it are the likely cause (a Su membrane at \
-         Table 1's mass did; three times heavier, [membrane] mass_scale = 3, it did not; more \
+         1-1.5 times Table 1's mass did; three times heavier, [membrane] mass_scale = 3, it did not; more \
          [bonds] damping did not help: docs/stability.md, \"Damped membrane bonds\"); from the \
          first outputs, the scene's u_max is too low for the flow",
         steps[first], times[first], steps[peak_at], times[peak_at], steps[first]

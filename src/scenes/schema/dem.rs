@@ -123,7 +123,10 @@ pub struct MembraneSection {
     /// model's confinement, not material of the sample. Until 2026-11-29 a membrane that shows
     /// the liquid its velocity (`[shear_cell] membrane_boundary = "moving"`) needed grains 2.5
     /// times the liquid's density; it now needs damped bonds instead (`[bonds] params.damping`,
-    /// docs/su2020.md, "The membrane's bonds must be damped").
+    /// docs/su2020.md, "The membrane's bonds must be damped"). Over runs past u_y = 2 d̄ at
+    /// Table 1's masses it needs both: membranes up to 1.35 times the liquid's density rang
+    /// or blew up, 1.80 and 2.7 times did not, and one under 1.8 is warned before the run
+    /// (`MOVING_MEMBRANE_DENSITY_RATIO_WARN`; docs/stability.md, "Damped membrane bonds").
     #[serde(default = "one")]
     pub mass_scale: f64,
 }

@@ -326,6 +326,35 @@ fn moving_membrane(s: String) -> String {
     .replace("lambda = 0.5 }", "lambda = 0.5, damping = 0.2 }")
 }
 
+/// A moving membrane boundary with membrane grains lighter than
+/// `MOVING_MEMBRANE_DENSITY_RATIO_WARN` times the liquid is warned before it starts, and the
+/// warning is in the summary with the factor that would pass; a heavier membrane is not. (Simulation
+/// I at 0.90, 1.08 and 1.35 times the liquid's density rang after 2 d̄, at 1.80 and 2.7 it did
+/// not; docs/stability.md, "Damped membrane bonds".)
+#[test]
+fn a_moving_membrane_lighter_than_the_map_allows_is_warned_with_the_factor_that_passes() {
+    for (factor, warned) in [(1.0, true), (3.0, false)] {
+        let t = tempfile::tempdir().unwrap();
+        let text = cell(t.path(), |s| {
+            moving_membrane(shorter("0.001")(s))
+                .replace("[membrane]\n", &format!("[membrane]\nmass_scale = {factor}\n"))
+        });
+        assert!(text.contains(&format!("mass_scale = {factor}")));
+        let rec = simulate(&text, t.path(), false).unwrap();
+        let w = rec.output.summary["warnings"].to_string();
+        if warned {
+            // The paper's membrane: 2658 / 2948 = 0.902 of the liquid's density.
+            assert!(
+                w.contains("[dem] mass_scale = 1 makes the membrane grains 0.902 times"),
+                "{w}"
+            );
+            assert!(w.contains("[membrane] mass_scale = 2.00 or more"), "{w}");
+        } else {
+            assert!(!w.contains("membrane_boundary"), "{w}");
+        }
+    }
+}
+
 /// A run refused before it starts: the message names `needle` and `fix`, and nothing is left
 /// in `dir`.
 fn assert_refused(got: anyhow::Result<StageRecord>, needle: &str, fix: &str, dir: &Path) {
