@@ -665,14 +665,15 @@ pub const MOVING_MEMBRANE_DENSITY_RATIO_WARN: f64 = 1.8;
 /// mass scale `scale`, the bottom of a mass-scale ladder if there is one) is under it.
 fn light_membrane<T: Real>(run: &Coupled<T>, s: &Scene, scale: f64) -> Option<String> {
     let at = s.dem.as_ref().map_or(1.0, |d| d.mass_scale);
-    let b = &run.sys.bodies;
+    let density = &run.sys.bodies.density;
     let membrane = run.sys.membrane.as_ref()?;
+    // as `light_grains` reads `lightest_wet_density`: per area over the depth, at `scale`
     let lightest = membrane
         .bodies
         .iter()
-        .map(|&k| b.density[k as usize] / run.depth * scale / at)
+        .map(|&k| density[k as usize])
         .fold(f64::INFINITY, f64::min);
-    let ratio = lightest / run.liquid_density();
+    let ratio = lightest / run.depth * scale / at / run.liquid_density();
     if ratio >= MOVING_MEMBRANE_DENSITY_RATIO_WARN {
         return None;
     }
